@@ -1,0 +1,37 @@
+// The smtcal driver's subcommands. Each lives in its own tools/cmd_*.cpp and
+// registers itself on the CLI11 app; the work itself is in the core library.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "frontend/diagnostics.h"
+#include "frontend/result.h"
+
+namespace smtcal::tools {
+
+// Documented in README.md and `smtcal --help`.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitInputError = 1,  // the input has errors (diagnostics were printed)
+  kExitUsageError = 2,  // bad command line
+  kExitIoError = 3,     // a file could not be read or written
+};
+
+struct GlobalOptions {
+  std::string diagnostics_format = "text";  // text | json
+  int exit_code = kExitOk;
+};
+
+// Prints the diagnostics to stderr in the chosen format. Returns
+// kExitInputError if any is an error, else kExitOk.
+int PrintDiagnostics(const Diagnostics& diags, const GlobalOptions& options);
+// Prints "smtcal: error: <message>" to stderr and returns kExitIoError.
+int ReportIoError(const Error& error);
+
+void AddCheckCommand(CLI::App& app, GlobalOptions& options);
+void AddFmtCommand(CLI::App& app, GlobalOptions& options);
+void AddTableCommand(CLI::App& app, GlobalOptions& options);
+
+}  // namespace smtcal::tools
