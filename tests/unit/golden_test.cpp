@@ -1,0 +1,148 @@
+// Golden-file tests: each case is an input beside its expected output.
+//
+// A suite is a folder tests/golden/<suite>/ with an ARGS file holding the
+// smtcal arguments ({input} stands for the case's file name). Every other
+// file that is not *.out, *.err, *.args or ARGS is a case. The harness runs
+// smtcal in the suite folder and compares stdout with <case>.out and stderr
+// with <case>.err (a missing file means "expected empty"). A case named
+// fail_* must exit 1; every other case must exit 0. <case>.args overrides
+// ARGS for one case.
+//
+// SMTCAL_UPDATE_GOLDEN=1 rewrites the expectations instead of comparing, so a
+// reviewer reads the change as a diff.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <cctype>
+#include <tuple>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct GoldenCase {
+  fs::path suite;      // folder
+  std::string input;   // file name inside the folder
+};
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+void WriteOrRemove(const fs::path& path, const std::string& text) {
+  if (text.empty()) {
+    fs::remove(path);
+    return;
+  }
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string Trim(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
+    text.pop_back();
+  }
+  return text;
+}
+
+bool IsExpectation(const fs::path& path) {
+  std::string ext = path.extension().string();
+  return ext == ".out" || ext == ".err" || ext == ".args" || path.filename() == "ARGS" ||
+         path.filename().string().rfind(".tmp", 0) == 0;
+}
+
+std::vector<GoldenCase> DiscoverCases() {
+  std::vector<GoldenCase> cases;
+  fs::path root = fs::path(SMTCAL_SOURCE_DIR) / "tests" / "golden";
+  if (!fs::exists(root)) return cases;
+  for (const auto& suite : fs::directory_iterator(root)) {
+    if (!suite.is_directory() || !fs::exists(suite.path() / "ARGS")) continue;
+    for (const auto& entry : fs::directory_iterator(suite.path())) {
+      if (!entry.is_regular_file() || IsExpectation(entry.path())) continue;
+      cases.push_back({suite.path(), entry.path().filename().string()});
+    }
+  }
+  std::sort(cases.begin(), cases.end(), [](const GoldenCase& a, const GoldenCase& b) {
+    return std::tie(a.suite, a.input) < std::tie(b.suite, b.input);
+  });
+  return cases;
+}
+
+std::string TestName(const testing::TestParamInfo<GoldenCase>& info) {
+  std::string name = info.param.suite.filename().string() + "_" + info.param.input;
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+std::string ShellQuote(const std::string& text) {
+  std::string quoted = "'";
+  for (char c : text) {
+    if (c == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "'";
+}
+
+class GoldenFiles : public testing::TestWithParam<GoldenCase> {};
+
+TEST_P(GoldenFiles, MatchesExpectedOutput) {
+  const GoldenCase& c = GetParam();
+  fs::path stem = c.suite / fs::path(c.input).stem();
+  fs::path args_file = fs::exists(stem.string() + ".args") ? fs::path(stem.string() + ".args")
+                                                            : c.suite / "ARGS";
+  std::string args = Trim(ReadFile(args_file));
+  for (std::size_t at; (at = args.find("{input}")) != std::string::npos;) {
+    args.replace(at, 7, ShellQuote(c.input));
+  }
+  fs::path out_file = c.suite / fmt::format(".tmp.{}.out", c.input);
+  fs::path err_file = c.suite / fmt::format(".tmp.{}.err", c.input);
+  std::string command = fmt::format("cd {} && {} {} </dev/null >{} 2>{}", ShellQuote(c.suite.string()),
+                                    ShellQuote(SMTCAL_BINARY), args,
+                                    ShellQuote(out_file.string()), ShellQuote(err_file.string()));
+  int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << command;
+  int exit_code = WEXITSTATUS(status);
+  std::string out = ReadFile(out_file);
+  std::string err = ReadFile(err_file);
+  fs::remove(out_file);
+  fs::remove(err_file);
+
+  bool must_fail = c.input.rfind("fail_", 0) == 0;
+  EXPECT_EQ(exit_code, must_fail ? 1 : 0) << "command: " << command << "\nstderr:\n" << err;
+
+  fs::path expected_out = stem.string() + ".out";
+  fs::path expected_err = stem.string() + ".err";
+  const char* update = std::getenv("SMTCAL_UPDATE_GOLDEN");
+  if (update != nullptr && std::string(update) == "1") {
+    WriteOrRemove(expected_out, out);
+    WriteOrRemove(expected_err, err);
+    return;
+  }
+  EXPECT_EQ(out, ReadFile(expected_out)) << "stdout of: " << command;
+  EXPECT_EQ(err, ReadFile(expected_err)) << "stderr of: " << command;
+  if (must_fail) {
+    EXPECT_NE(err.find("error"), std::string::npos) << "a fail_ case must report an error";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Golden, GoldenFiles, testing::ValuesIn(DiscoverCases()), TestName);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(GoldenFiles);
+
+}  // namespace
