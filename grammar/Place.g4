@@ -5,7 +5,10 @@
 grammar Place;
 
 // ---------------------------------------------------------------- structure
-program     : (topLevel? NEWLINE)* topLevel? EOF ;
+// Every line ends in NEWLINE: frontend/parse.cpp adds one after a last line
+// that lacks it. (Allowing "topLevel? EOF" here would make ANTLR look ahead
+// through a whole Function to choose between the two ways to end a line.)
+program     : (topLevel? NEWLINE)* EOF ;
 
 topLevel    : programDecl
             | unitsDecl
@@ -26,7 +29,10 @@ pointDecl   : TAUGHT? POINT ID '=' coords ((IN | ON) ID)? ;
 palletDecl  : PALLET NUMBER ',' ID ',' ID ',' ID ',' NUMBER ',' NUMBER ;
 vacuumDecl  : VACUUM NUMBER ;
 varDecl     : (INTEGER | REAL) ID (',' ID)* ;
-functionDecl: FUNCTION ID ('(' ')')? NEWLINE block FEND ;
+functionDecl: functionHead NEWLINE block FEND ;
+// The opening line of each block is its own rule, so that a mistake on that
+// line is recovered inside it and never abandons the whole block.
+functionHead: FUNCTION ID ('(' ')')? ;
 
 coords      : XY '(' signedNumber ',' signedNumber ',' signedNumber ',' signedNumber ')' ;
 signedNumber: ('-' | '+')? NUMBER ;
@@ -51,15 +57,19 @@ assignment  : ID '=' expr ;
 motion      : (JUMP | GO | MOVE) pointExpr (LIMZ expr)? ;
 pickPlace   : (PICK | PLACE) pointExpr (VACUUM expr)? (LIMZ expr)? ;
 onOff       : (ON | OFF) expr ;
-waitStmt    : WAIT SW '(' expr ')' '=' (ON | OFF)      # waitSwitch
-            | WAIT expr                                # waitTime
-            ;
-forStmt     : FOR ID '=' expr TO expr (STEP expr)? NEWLINE block NEXT ID? ;
-ifStmt      : IF expr THEN NEWLINE block elseIfPart* elsePart? ENDIF ;
-elseIfPart  : ELSEIF expr THEN NEWLINE block ;
+// Wait Sw(n) = On|Off waits for an input; any other Wait expr waits that
+// many seconds. Both are one rule (LL(1)); the visitor tells them apart.
+waitStmt    : WAIT expr ;
+forStmt     : forHead NEWLINE block NEXT ID? ;
+forHead     : FOR ID '=' expr TO expr (STEP expr)? ;
+ifStmt      : ifHead NEWLINE block elseIfPart* elsePart? ENDIF ;
+ifHead      : IF expr THEN ;
+elseIfPart  : elseIfHead NEWLINE block ;
+elseIfHead  : ELSEIF expr THEN ;
 elsePart    : ELSE NEWLINE block ;
 callStmt    : CALL ID ('(' ')')? ;
-cycleStmt   : CYCLE ID NEWLINE block ENDCYCLE ;
+cycleStmt   : cycleHead NEWLINE block ENDCYCLE ;
+cycleHead   : CYCLE ID ;
 scanStmt    : SCAN ID ;
 exitStmt    : EXIT FUNCTION ;
 
@@ -131,6 +141,21 @@ OR       : O R ;
 XOR      : X O R ;
 NOT      : N O T ;
 MOD      : M O D ;
+
+// Punctuation has names so that frontend/parse.cpp can talk about it.
+EQ       : '=' ;
+NE       : '<>' ;
+LE       : '<=' ;
+GE       : '>=' ;
+LT       : '<' ;
+GT       : '>' ;
+COMMA    : ',' ;
+LPAREN   : '(' ;
+RPAREN   : ')' ;
+PLUS     : '+' ;
+MINUS    : '-' ;
+STAR     : '*' ;
+SLASH    : '/' ;
 
 NUMBER   : DIGIT+ ('.' DIGIT*)? EXPONENT? | '.' DIGIT+ EXPONENT? ;
 ID       : [a-zA-Z_] [a-zA-Z_0-9]* ;

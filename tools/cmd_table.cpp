@@ -1,10 +1,227 @@
+// `smtcal table build|check|stats|forward|inverse|plot`: the error tables of
+// a calibrated region (docs/error-tables.md). The work is in
+// frontend/table_csv, passes/error_table*, passes/inverse_calibration and
+// backend/table_*; this file only wires files, options and exit codes.
+#include <filesystem>
+#include <optional>
+
+#include "backend/table_plot.h"
+#include "backend/table_report.h"
+#include "frontend/table_csv.h"
+#include "passes/error_table_build.h"
+#include "passes/error_table_check.h"
+#include "passes/inverse_calibration.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {
+namespace {
+
+struct TableOptions {
+  std::string input;   // the table (or raw file for build)
+  std::string points = "-";
+  std::string output = "-";
+  bool json = false;
+  std::string outside = "error";
+  std::string solver = "default";
+  double paper_tolerance_mm = kPaperSolverTolMm;
+};
+
+std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// Loads and validates a table. Returns nullopt after setting the exit code
+// (I/O error, or input errors printed); diagnostics are printed by the caller
+// on success (warnings).
+std::optional<ErrorTable> LoadTable(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                    TableWarnings warnings, GlobalOptions& options,
+                                    TableAnalysis* analysis = nullptr) {
+  Result<std::uint32_t> file = sources.Load(path);
+  if (!file) {
+    options.exit_code = ReportIoError(file.error());
+    return std::nullopt;
+  }
+  std::optional<ErrorTable> table = ReadErrorTable(file.value(), diags);
+  if (table && !ValidateErrorTable(*table, diags, warnings, analysis)) table.reset();
+  if (!table) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return std::nullopt;
+  }
+  return table;
+}
+
+void Finish(const Diagnostics& diags, GlobalOptions& options, const std::string& output, const std::string& text) {
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (options.exit_code != kExitOk) return;
+  Status written = WriteFileAtomically(output, text);
+  if (!written) options.exit_code = ReportIoError(written.error());
+}
+
+OutsidePolicy ParsePolicy(const std::string& name) {
+  if (name == "clamp") return OutsidePolicy::kClamp;
+  if (name == "none") return OutsidePolicy::kNone;
+  return OutsidePolicy::kError;
+}
+
+void RunBuild(const TableOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Result<std::uint32_t> file = sources.Load(opt.input);
+  if (!file) {
+    options.exit_code = ReportIoError(file.error());
+    return;
+  }
+  Diagnostics diags(sources);
+  std::optional<std::vector<RawMeasurement>> raw = ReadRawMeasurements(file.value(), diags);
+  std::optional<ErrorTable> table;
+  if (raw) table = BuildErrorTable(BaseName(opt.input), *raw, SourceLoc{file.value(), 0, 0}, diags);
+  if (table) ValidateErrorTable(*table, diags, TableWarnings::kReport);
+  std::string text;
+  if (table && !diags.has_errors()) {
+    text = FormatTableCsv(*table, BuiltTableComment(BaseName(opt.input)));
+  }
+  Finish(diags, options, opt.output, text);
+}
+
+void RunCheck(const TableOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  if (LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
+    options.exit_code = PrintDiagnostics(diags, options);
+  }
+}
+
+void RunStats(const TableOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  TableAnalysis analysis;
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options, &analysis);
+  if (!table) return;
+  table->name = BaseName(table->name);
+  TableStats stats = ComputeTableStats(*table);
+  int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+  Finish(diags, options, "-",
+         opt.json ? FormatStatsJson(*table, stats, analysis, bound) : FormatStatsText(*table, stats, analysis, bound));
+}
+
+void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  TableAnalysis analysis;
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options, &analysis);
+  if (!table) return;
+  Result<std::uint32_t> file = sources.Load(opt.points);
+  if (!file) {
+    options.exit_code = ReportIoError(file.error());
+    return;
+  }
+  std::optional<std::vector<PointRow>> points = ReadPoints(file.value(), diags);
+  if (!points) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
+  const OutsidePolicy policy = ParsePolicy(opt.outside);
+  std::optional<InverseSolver> solver;
+  std::optional<PaperSolver> paper;
+  if (inverse && opt.solver == "paper") {
+    paper.emplace(*table, opt.paper_tolerance_mm);
+  } else if (inverse) {
+    solver.emplace(*table, analysis);
+  }
+  CalibrationMap map(*table);
+  const Rect& domain = map.domain();
+  std::vector<Solution> solutions;
+  for (const PointRow& row : *points) {
+    Solution s = paper    ? paper->Solve(row.point, policy)
+                 : solver ? solver->Solve(row.point, policy)
+                          : DirectCalibrate(map, row.point, policy);
+    SMTCAL_CHECK(paper || s.status != SolveStatus::kNotConverged,
+                 "the default inverse solver exceeded the iteration bound proven for this table");
+    if (s.status == SolveStatus::kOutside) {
+      std::string detail = inverse ? fmt::format("; the nominal position that reaches it would be ({}, {})",
+                                                 FormatMm(s.point.x()), FormatMm(s.point.y()))
+                                   : "";
+      diags.Report(DiagKind::PointOutsideTable, row.range, FormatMm(row.point.x()), FormatMm(row.point.y()),
+                   FormatMm(domain.x0), FormatMm(domain.x1), FormatMm(domain.y0), FormatMm(domain.y1), detail);
+    } else if (s.status == SolveStatus::kNotConverged) {
+      diags.Report(DiagKind::PaperSolverNotConverged, row.range, s.iterations, fmt::format("{:.3e}", s.residual_mm),
+                   FormatMm(row.point.x()), FormatMm(row.point.y()), FormatMm(paper->tolerance_mm()));
+    }
+    solutions.push_back(s);
+  }
+  Finish(diags, options, opt.output, FormatSolutionsCsv(solutions));
+}
+
+void RunPlot(const TableOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
+  if (!table) return;
+  Finish(diags, options, opt.output, PlotTableSvg(*table, BaseName(table->name)));
+}
+
+}  // namespace
 
 void AddTableCommand(CLI::App& app, GlobalOptions& options) {
-  CLI::App* table = app.add_subcommand("table", "Build, check and use error tables (not yet built)");
-  table->callback([&options] { options.exit_code = kExitUsageError; });
+  static TableOptions opt;
+  CLI::App* table = app.add_subcommand(
+      "table", "Build, check and use error tables: the robot's measured position errors (docs/error-tables.md)");
+  table->require_subcommand(1);
+
+  CLI::App* build = table->add_subcommand(
+      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm) into an error table;\n"
+               "warns about nodes whose scatter or set-to-set difference is far above the rest");
+  build->add_option("RAW", opt.input, "the raw measurement CSV ('-' for stdin)")->required();
+  build->add_option("-o,--output", opt.output, "the error table to write ('-' for stdout)")->required();
+  build->callback([&options] { RunBuild(opt, options); });
+
+  CLI::App* check = table->add_subcommand(
+      "check", "Validate an error table: grid, values, no fold (det(I + grad Delta) >= 0.5), slopes,\n"
+               "and warn where the error changes sign between nodes or exceeds half the pitch");
+  check->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  check->callback([&options] { RunCheck(opt, options); });
+
+  CLI::App* stats = table->add_subcommand(
+      "stats", "The paper's statistics per axis (max, min, mean, origin shift by the means, max |Delta - mean|,\n"
+               "stddev summary) and the inverse calibration's contraction factor and iteration bound");
+  stats->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  stats->add_flag("--json", opt.json, "print JSON instead of text");
+  stats->callback([&options] { RunStats(opt, options); });
+
+  for (bool inverse : {false, true}) {
+    CLI::App* solve = table->add_subcommand(
+        inverse ? "inverse" : "forward",
+        inverse ? "Inverse calibration: the nominal positions n that reach the required actual positions a\n"
+                  "(F(n) = a); prints x_mm,y_mm,residual_mm,iterations"
+                : "Direct calibration: the actual positions F(n) = n + Delta(n) the robot reaches when\n"
+                  "commanded to n; prints x_mm,y_mm,residual_mm,iterations (residual and iterations 0)");
+    solve->add_option("TABLE", opt.input, "the error table CSV")->required();
+    solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
+        ->capture_default_str();
+    solve->add_option("-o,--output", opt.output, "where to write the results ('-' for stdout)")
+        ->capture_default_str();
+    solve->add_option("--outside", opt.outside,
+                      "points outside the table: error (refuse), clamp (use the edge values),\n"
+                      "none (leave uncorrected)")
+        ->check(CLI::IsMember({"error", "clamp", "none"}))
+        ->capture_default_str();
+    if (inverse) {
+      solve->add_option("--solver", opt.solver,
+                        "default (Newton guarded by the contracting fixed-point step, residual <= 1e-9 mm)\n"
+                        "or paper (the paper's iterative interval search)")
+          ->check(CLI::IsMember({"default", "paper"}))
+          ->capture_default_str();
+      solve->add_option("--paper-tolerance", opt.paper_tolerance_mm,
+                        "the paper solver's stopping tolerance in mm")
+          ->check(CLI::PositiveNumber)
+          ->capture_default_str();
+    }
+    solve->callback([&options, inverse] { RunSolve(opt, options, inverse); });
+  }
+
+  CLI::App* plot = table->add_subcommand(
+      "plot", "Draw the error field as SVG: colour maps of Delta-x and Delta-y (µm), grid nodes,\n"
+              "and the error vectors as enlarged arrows with a scale bar");
+  plot->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  plot->add_option("-o,--output", opt.output, "the SVG file to write ('-' for stdout)")->required();
+  plot->callback([&options] { RunPlot(opt, options); });
 }
 
 }  // namespace smtcal::tools

@@ -1,0 +1,402 @@
+#include "backend/place_printer.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string_view>
+#include <type_traits>
+
+#include "frontend/check.h"
+
+namespace smtcal {
+namespace {
+
+// Reals print in plain decimal inside this magnitude range and with an
+// exponent outside it, so neither 1e-9 nor 1e20 becomes a wall of zeros.
+constexpr double kSmallestPlainReal = 1e-5;
+constexpr double kLargestPlainReal = 1e15;
+
+// Binding strength, from the grammar's expr rule (ANTLR gives the earlier
+// alternative the higher precedence). All binary operators are
+// left-associative. A unary operator's operand is a primary or another unary
+// expression, so `-a * b` is (-a) * b and `Not a = b` is (Not a) = b.
+enum Precedence : int {
+  kOrXor = 1,
+  kAnd = 2,
+  kComparison = 3,
+  kAdditive = 4,
+  kMultiplicative = 5,
+  kUnary = 6,
+  kPrimary = 7,
+};
+
+int BinaryPrecedence(ir::BinaryOp op) {
+  switch (op) {
+    case ir::BinaryOp::Or:
+    case ir::BinaryOp::Xor: return kOrXor;
+    case ir::BinaryOp::And: return kAnd;
+    case ir::BinaryOp::Eq:
+    case ir::BinaryOp::Ne:
+    case ir::BinaryOp::Lt:
+    case ir::BinaryOp::Gt:
+    case ir::BinaryOp::Le:
+    case ir::BinaryOp::Ge: return kComparison;
+    case ir::BinaryOp::Add:
+    case ir::BinaryOp::Sub: return kAdditive;
+    case ir::BinaryOp::Mul:
+    case ir::BinaryOp::Div:
+    case ir::BinaryOp::Mod: return kMultiplicative;
+  }
+  SMTCAL_CHECK(false, "unknown binary operator");
+  return 0;
+}
+
+std::string_view BinaryOpText(ir::BinaryOp op) {
+  switch (op) {
+    case ir::BinaryOp::Add: return "+";
+    case ir::BinaryOp::Sub: return "-";
+    case ir::BinaryOp::Mul: return "*";
+    case ir::BinaryOp::Div: return "/";
+    case ir::BinaryOp::Mod: return "Mod";
+    case ir::BinaryOp::Eq: return "=";
+    case ir::BinaryOp::Ne: return "<>";
+    case ir::BinaryOp::Lt: return "<";
+    case ir::BinaryOp::Gt: return ">";
+    case ir::BinaryOp::Le: return "<=";
+    case ir::BinaryOp::Ge: return ">=";
+    case ir::BinaryOp::And: return "And";
+    case ir::BinaryOp::Or: return "Or";
+    case ir::BinaryOp::Xor: return "Xor";
+  }
+  SMTCAL_CHECK(false, "unknown binary operator");
+  return "";
+}
+
+int ExprPrecedence(const ir::Expr& expr) {
+  if (const auto* binary = std::get_if<ir::BinaryExpr>(&expr.node)) {
+    return BinaryPrecedence(binary->op);
+  }
+  if (std::holds_alternative<ir::UnaryExpr>(expr.node)) return kUnary;
+  return kPrimary;
+}
+
+std::string Parenthesized(const ir::Expr& expr, bool parenthesize) {
+  std::string text = PrintExpr(expr);
+  return parenthesize ? "(" + text + ")" : text;
+}
+
+std::string_view AxisText(ir::Axis axis) {
+  switch (axis) {
+    case ir::Axis::X: return "X";
+    case ir::Axis::Y: return "Y";
+    case ir::Axis::Z: return "Z";
+    case ir::Axis::U: return "U";
+  }
+  SMTCAL_CHECK(false, "unknown axis");
+  return "";
+}
+
+std::string CoordsText(const ir::Coords& coords) {
+  std::string text = "XY(";
+  for (std::size_t i = 0; i < coords.values.size(); ++i) {
+    if (i > 0) text += ", ";
+    text += FormatRealLiteral(coords.values[i]);
+  }
+  return text + ")";
+}
+
+bool SameNameIgnoringCase(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+    if (lower(a[i]) != lower(b[i])) return false;
+  }
+  return true;
+}
+
+class Printer {
+ public:
+  std::string Print(const ir::Program& program) {
+    PrintBlock(program.items, 0);
+    return std::move(out_);
+  }
+
+ private:
+  // One output line: indentation, text, and the comment written on it.
+  void Line(int depth, std::string_view text, std::string_view comment) {
+    out_.append(static_cast<std::size_t>(depth) * 2, ' ');
+    out_ += text;
+    out_ += comment;
+    out_ += '\n';
+  }
+
+  // "  'text" for a trailing comment; nothing when there is none. The IR
+  // keeps a comment's text without its '; an empty string means no comment,
+  // so a bare ' at the end of a line is not representable and not printed.
+  static std::string CommentSuffix(std::string_view comment) {
+    if (comment.empty()) return {};
+    return "  '" + std::string(comment);
+  }
+
+  void PrintBlock(const ir::Block& block, int depth) {
+    for (std::size_t i = 0; i < block.size(); ++i) {
+      SMTCAL_CHECK(block[i] != nullptr, "null statement in a block");
+      // At most one blank line (the IR holds a flag), and never as the first
+      // line of the file or of a block, where it separates nothing.
+      if (i > 0 && block[i]->blank_line_before) out_ += '\n';
+      PrintStmt(*block[i], depth);
+    }
+  }
+
+  void End(int depth, std::string_view keyword, const ir::BlockEnd& end) {
+    Line(depth, keyword, CommentSuffix(end.comment));
+  }
+
+  void PrintStmt(const ir::Stmt& stmt, int depth) {
+    std::string comment = CommentSuffix(stmt.trailing_comment);
+    std::visit(
+        [&](const auto& node) {
+          using Node = std::decay_t<decltype(node)>;
+          if constexpr (std::is_same_v<Node, ir::Comment>) {
+            Line(depth, "'" + node.text, "");
+          } else if constexpr (std::is_same_v<Node, ir::ProgramDecl>) {
+            Line(depth, "Program " + node.name, comment);
+          } else if constexpr (std::is_same_v<Node, ir::UnitsDecl>) {
+            Line(depth, "Units " + node.unit, comment);
+          } else if constexpr (std::is_same_v<Node, ir::FixtureDecl>) {
+            Line(depth, "Fixture " + node.name, comment);
+          } else if constexpr (std::is_same_v<Node, ir::LocalDecl>) {
+            std::string text = "Local " + node.name + " = " + CoordsText(node.origin);
+            if (!node.frame.empty()) text += " In " + node.frame;
+            Line(depth, text, comment);
+          } else if constexpr (std::is_same_v<Node, ir::PointDecl>) {
+            // The IR does not say whether In or On was written: a programmed
+            // point is given In a frame, a taught point was taught On a fixture.
+            std::string text = std::string(node.taught ? "Taught Point " : "Point ") + node.name +
+                               " = " + CoordsText(node.coords);
+            if (!node.frame.empty()) text += (node.taught ? " On " : " In ") + node.frame;
+            Line(depth, text, comment);
+          } else if constexpr (std::is_same_v<Node, ir::PalletDecl>) {
+            Line(depth,
+                 "Pallet " + std::to_string(node.number) + ", " + node.corners[0] + ", " +
+                     node.corners[1] + ", " + node.corners[2] + ", " +
+                     std::to_string(node.columns) + ", " + std::to_string(node.rows),
+                 comment);
+          } else if constexpr (std::is_same_v<Node, ir::VacuumDecl>) {
+            Line(depth, "Vacuum " + std::to_string(node.output), comment);
+          } else if constexpr (std::is_same_v<Node, ir::VarDecl>) {
+            std::string text = node.type == ir::VarType::Integer ? "Integer " : "Real ";
+            for (std::size_t i = 0; i < node.names.size(); ++i) {
+              if (i > 0) text += ", ";
+              text += node.names[i];
+            }
+            Line(depth, text, comment);
+          } else if constexpr (std::is_same_v<Node, ir::Function>) {
+            Line(depth, "Function " + node.name, comment);
+            PrintBlock(node.body, depth + 1);
+            End(depth, "Fend", node.end);
+          } else if constexpr (std::is_same_v<Node, ir::Assign>) {
+            Line(depth, node.name + " = " + PrintExpr(*node.value), comment);
+          } else if constexpr (std::is_same_v<Node, ir::Motion>) {
+            std::string text = node.kind == ir::MotionKind::Jump ? "Jump "
+                               : node.kind == ir::MotionKind::Go ? "Go "
+                                                                 : "Move ";
+            text += PrintPointExpr(node.target);
+            if (node.limz) text += " LimZ " + PrintExpr(*node.limz);
+            Line(depth, text, comment);
+          } else if constexpr (std::is_same_v<Node, ir::PickPlace>) {
+            std::string text = node.kind == ir::PickPlaceKind::Pick ? "Pick " : "Place ";
+            text += PrintPointExpr(node.target);
+            if (node.vacuum) text += " Vacuum " + PrintExpr(*node.vacuum);
+            if (node.limz) text += " LimZ " + PrintExpr(*node.limz);
+            Line(depth, text, comment);
+          } else if constexpr (std::is_same_v<Node, ir::SetOutput>) {
+            Line(depth, (node.on ? "On " : "Off ") + PrintExpr(*node.bit), comment);
+          } else if constexpr (std::is_same_v<Node, ir::WaitTime>) {
+            // The parser reads any `Wait Sw(n) = On|Off`, parenthesized or
+            // not, as WaitSwitch, so a WaitTime never has that shape.
+            Line(depth, "Wait " + PrintExpr(*node.seconds), comment);
+          } else if constexpr (std::is_same_v<Node, ir::WaitSwitch>) {
+            Line(depth, "Wait Sw(" + PrintExpr(*node.bit) + ") = " + (node.on ? "On" : "Off"),
+                 comment);
+          } else if constexpr (std::is_same_v<Node, ir::For>) {
+            std::string text = "For " + node.var + " = " + PrintExpr(*node.from) + " To " +
+                               PrintExpr(*node.to);
+            if (node.step) text += " Step " + PrintExpr(*node.step);
+            Line(depth, text, comment);
+            PrintBlock(node.body, depth + 1);
+            // `Next` always names its loop variable, spelled as in the For
+            // line; a Next naming some other variable is the user's mistake,
+            // kept as written for the checker to report.
+            bool names_other = !node.next_var.empty() && !SameNameIgnoringCase(node.next_var, node.var);
+            End(depth, "Next " + (names_other ? node.next_var : node.var), node.end);
+          } else if constexpr (std::is_same_v<Node, ir::If>) {
+            for (std::size_t i = 0; i < node.branches.size(); ++i) {
+              const ir::IfBranch& branch = node.branches[i];
+              if (i == 0) {
+                SMTCAL_CHECK(branch.condition != nullptr, "If without a condition");
+                Line(depth, "If " + PrintExpr(*branch.condition) + " Then", comment);
+              } else if (branch.condition) {
+                Line(depth, "ElseIf " + PrintExpr(*branch.condition) + " Then",
+                     CommentSuffix(branch.comment));
+              } else {
+                Line(depth, "Else", CommentSuffix(branch.comment));
+              }
+              PrintBlock(branch.body, depth + 1);
+            }
+            End(depth, "EndIf", node.end);
+          } else if constexpr (std::is_same_v<Node, ir::Call>) {
+            Line(depth, "Call " + node.name, comment);
+          } else if constexpr (std::is_same_v<Node, ir::Cycle>) {
+            Line(depth, "Cycle " + node.fixture, comment);
+            PrintBlock(node.body, depth + 1);
+            End(depth, "EndCycle", node.end);
+          } else if constexpr (std::is_same_v<Node, ir::Scan>) {
+            Line(depth, "Scan " + node.fixture, comment);
+          } else if constexpr (std::is_same_v<Node, ir::ExitFunction>) {
+            Line(depth, "Exit Function", comment);
+          } else {
+            static_assert(sizeof(Node) == 0, "statement kind not printed");
+          }
+        },
+        stmt.node);
+  }
+
+  std::string out_;
+};
+
+}  // namespace
+
+std::string FormatRealLiteral(double value) {
+  SMTCAL_CHECK(std::isfinite(value), "non-finite number literal");
+  double magnitude = std::fabs(value);
+  bool plain = magnitude == 0 || (magnitude >= kSmallestPlainReal && magnitude < kLargestPlainReal);
+  char buffer[64];
+  auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value,
+                                    plain ? std::chars_format::fixed : std::chars_format::scientific);
+  SMTCAL_CHECK(error == std::errc(), "number does not fit the format buffer");
+  std::string text(buffer, end);
+  if (plain) {
+    if (text.find('.') == std::string::npos) text += ".0";
+    return text;
+  }
+  // to_chars writes "2.5e-07" or "1e+20"; canonical is "2.5e-7" and "1.0e20".
+  std::size_t e = text.find('e');
+  std::string mantissa = text.substr(0, e);
+  if (mantissa.find('.') == std::string::npos) mantissa += ".0";
+  std::string exponent = text.substr(e + 1);
+  std::string sign;
+  if (exponent[0] == '+' || exponent[0] == '-') {
+    if (exponent[0] == '-') sign = "-";
+    exponent.erase(0, 1);
+  }
+  exponent.erase(0, std::min(exponent.find_first_not_of('0'), exponent.size() - 1));
+  return mantissa + "e" + sign + exponent;
+}
+
+std::string FormatIntegerLiteral(double value) {
+  SMTCAL_CHECK(std::isfinite(value) && value == std::trunc(value), "integer literal is not an integer");
+  // Shortest round-trip digits in plain notation: 99999999999999999999
+  // (stored as 1e20) prints as 100000000000000000000, which reads back the same.
+  char buffer[400];
+  auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
+  SMTCAL_CHECK(error == std::errc(), "number does not fit the format buffer");
+  return std::string(buffer, end);
+}
+
+std::string PrintExpr(const ir::Expr& expr) {
+  return std::visit(
+      [&](const auto& node) -> std::string {
+        using Node = std::decay_t<decltype(node)>;
+        if constexpr (std::is_same_v<Node, ir::NumberLit>) {
+          return node.is_integer ? FormatIntegerLiteral(node.value) : FormatRealLiteral(node.value);
+        } else if constexpr (std::is_same_v<Node, ir::VariableRef>) {
+          return node.name;
+        } else if constexpr (std::is_same_v<Node, ir::OnOffLit>) {
+          return node.on ? "On" : "Off";
+        } else if constexpr (std::is_same_v<Node, ir::UnaryExpr>) {
+          SMTCAL_CHECK(node.operand != nullptr, "unary expression without operand");
+          std::string operand = Parenthesized(*node.operand, ExprPrecedence(*node.operand) < kUnary);
+          switch (node.op) {
+            case ir::UnaryOp::Negate: return "-" + operand;
+            case ir::UnaryOp::Plus: return "+" + operand;
+            case ir::UnaryOp::Not: return "Not " + operand;
+          }
+          SMTCAL_CHECK(false, "unknown unary operator");
+          return "";
+        } else if constexpr (std::is_same_v<Node, ir::BinaryExpr>) {
+          SMTCAL_CHECK(node.lhs != nullptr && node.rhs != nullptr, "binary expression without operand");
+          // Left-associative: the left operand needs parentheses only when it
+          // binds looser, the right one also when it binds equally
+          // (a - (b - c) keeps them, (a - b) - c does not).
+          int precedence = BinaryPrecedence(node.op);
+          return Parenthesized(*node.lhs, ExprPrecedence(*node.lhs) < precedence) + " " +
+                 std::string(BinaryOpText(node.op)) + " " +
+                 Parenthesized(*node.rhs, ExprPrecedence(*node.rhs) <= precedence);
+        } else if constexpr (std::is_same_v<Node, ir::SwitchRead>) {
+          SMTCAL_CHECK(node.bit != nullptr, "Sw() without a bit");
+          return "Sw(" + PrintExpr(*node.bit) + ")";
+        } else {
+          static_assert(sizeof(Node) == 0, "expression kind not printed");
+        }
+      },
+      expr.node);
+}
+
+std::string PrintPointExpr(const ir::PointExpr& point) {
+  std::string text = std::visit(
+      [&](const auto& base) -> std::string {
+        using Base = std::decay_t<decltype(base)>;
+        if constexpr (std::is_same_v<Base, ir::NamedPoint>) {
+          return base.name;
+        } else if constexpr (std::is_same_v<Base, ir::Coords>) {
+          return CoordsText(base);
+        } else if constexpr (std::is_same_v<Base, ir::PalletPoint>) {
+          SMTCAL_CHECK(base.number != nullptr && base.i != nullptr, "Pallet() without its indexes");
+          std::string pallet = "Pallet(" + PrintExpr(*base.number) + ", " + PrintExpr(*base.i);
+          if (base.j) pallet += ", " + PrintExpr(*base.j);
+          return pallet + ")";
+        } else {
+          static_assert(sizeof(Base) == 0, "point kind not printed");
+        }
+      },
+      point.base);
+  for (const ir::PointOffset& offset : point.offsets) {
+    SMTCAL_CHECK(offset.amount != nullptr, "point offset without an amount");
+    text += offset.negative ? " - " : " + ";
+    text += AxisText(offset.axis);
+    text += "(" + PrintExpr(*offset.amount) + ")";
+  }
+  return text;
+}
+
+std::string PrintPlace(const ir::Program& program) { return Printer().Print(program); }
+
+namespace {
+
+void ApplyCanonicalChanges(ir::Block& block) {
+  for (std::size_t i = 0; i < block.size(); ++i) {
+    if (i == 0) block[i]->blank_line_before = false;
+    std::visit(
+        [](auto& node) {
+          using Node = std::decay_t<decltype(node)>;
+          if constexpr (std::is_same_v<Node, ir::Function> || std::is_same_v<Node, ir::Cycle>) {
+            ApplyCanonicalChanges(node.body);
+          } else if constexpr (std::is_same_v<Node, ir::For>) {
+            if (node.next_var.empty() || SameNameIgnoringCase(node.next_var, node.var)) {
+              node.next_var = node.var;
+            }
+            ApplyCanonicalChanges(node.body);
+          } else if constexpr (std::is_same_v<Node, ir::If>) {
+            for (ir::IfBranch& branch : node.branches) ApplyCanonicalChanges(branch.body);
+          }
+        },
+        block[i]->node);
+  }
+}
+
+}  // namespace
+
+void ApplyCanonicalChanges(ir::Program& program) { ApplyCanonicalChanges(program.items); }
+
+}  // namespace smtcal

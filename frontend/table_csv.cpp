@@ -1,0 +1,451 @@
+// Reading the error tables' CSV files (the dialect is described in
+// table_csv.h and docs/error-tables.md). Every mistake is a diagnostic at the
+// row's line and the offending field's column; a row with a mistake is left
+// out and reading goes on, so one run reports all of them.
+#include "frontend/table_csv.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string_view>
+
+#include <fast_float/fast_float.h>
+#include <fmt/format.h>
+
+#include "frontend/check.h"
+
+namespace smtcal {
+namespace {
+
+bool IsBlank(char c) { return c == ' ' || c == '\t'; }
+
+std::string Lowercase(std::string_view text) {
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower;
+}
+
+SourceLoc At(std::uint32_t file, std::uint32_t line, std::size_t offset) {
+  return SourceLoc{file, line, static_cast<std::uint32_t>(offset + 1)};
+}
+
+// Splits one line (without its line end) into fields. Returns false (after
+// reporting) on a quoting error.
+bool SplitLine(std::string_view line, std::uint32_t file, std::uint32_t number, std::size_t start,
+               CsvRecord& record, Diagnostics& diags) {
+  std::size_t i = start;
+  while (true) {
+    while (i < line.size() && IsBlank(line[i])) ++i;
+    CsvField field;
+    std::size_t begin = i;
+    if (i < line.size() && line[i] == '"') {
+      ++i;
+      while (true) {
+        if (i >= line.size()) {
+          diags.Report(DiagKind::CsvUnclosedQuote, SourceRange(At(file, number, begin), 1));
+          return false;
+        }
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') {
+            field.text += '"';
+            i += 2;
+            continue;
+          }
+          ++i;
+          break;
+        }
+        field.text += line[i++];
+      }
+      std::size_t end = i;
+      while (i < line.size() && IsBlank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') {
+        diags.Report(DiagKind::CsvStrayQuote, SourceRange(At(file, number, i), 1),
+                     "text after the closing quote of a field");
+        return false;
+      }
+      field.range = SourceRange(At(file, number, begin), static_cast<std::uint32_t>(end - begin));
+      // Spaces inside the quotes are kept out of numbers too.
+      std::string_view inner = field.text;
+      while (!inner.empty() && IsBlank(inner.front())) inner.remove_prefix(1);
+      while (!inner.empty() && IsBlank(inner.back())) inner.remove_suffix(1);
+      field.text = std::string(inner);
+    } else {
+      while (i < line.size() && line[i] != ',') {
+        if (line[i] == '"') {
+          diags.Report(DiagKind::CsvStrayQuote, SourceRange(At(file, number, i), 1),
+                       "'\"' inside an unquoted field");
+          return false;
+        }
+        ++i;
+      }
+      std::size_t end = i;
+      while (end > begin && IsBlank(line[end - 1])) --end;
+      field.text = std::string(line.substr(begin, end - begin));
+      field.range = SourceRange(At(file, number, begin), static_cast<std::uint32_t>(end - begin));
+    }
+    record.fields.push_back(std::move(field));
+    if (i < line.size() && line[i] == ',') {
+      ++i;
+      continue;
+    }
+    return true;
+  }
+}
+
+// ------------------------------------------------------------------ columns
+
+// What a file holds: its columns in their usual order, the first `required`
+// of them required.
+struct Schema {
+  std::string_view what;  // "an error table": for messages
+  std::vector<std::string_view> columns;
+  std::size_t required;
+  bool header_optional;  // a headerless file has the required columns in order
+};
+
+const Schema kTableSchema{"an error table", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
+const Schema kRawSchema{
+    "a raw measurement file", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
+const Schema kPointSchema{"a point list", {"x_mm", "y_mm"}, 2, true};
+
+std::string JoinColumns(const Schema& schema, std::size_t count) {
+  std::string text;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (i > 0) text += ", ";
+    text += schema.columns[i];
+  }
+  return text;
+}
+
+std::optional<double> ParseDouble(std::string_view text) {
+  if (!text.empty() && text.front() == '+') {
+    text.remove_prefix(1);
+    if (!text.empty() && (text.front() == '-' || text.front() == '+')) return std::nullopt;
+  }
+  if (text.empty()) return std::nullopt;
+  double value = 0;
+  auto [end, ec] = fast_float::from_chars(text.data(), text.data() + text.size(), value);
+  if (end != text.data() + text.size()) return std::nullopt;
+  if (ec != std::errc() && ec != std::errc::result_out_of_range) return std::nullopt;
+  if (ec == std::errc::result_out_of_range && std::abs(value) < 1) return 0.0;  // underflow
+  if (ec == std::errc::result_out_of_range) return HUGE_VAL;  // reported as not finite
+  return value;
+}
+
+// A header maps each of the schema's columns to a field index (or none).
+struct Header {
+  std::vector<std::optional<std::size_t>> field_of;  // per schema column
+  std::size_t field_count = 0;
+  std::vector<std::string_view> field_names;  // per field, for "missing: ..."
+};
+
+bool LooksLikeHeader(const CsvRecord& record, const Schema& schema) {
+  bool any_number = false;
+  for (const CsvField& field : record.fields) {
+    std::string name = Lowercase(field.text);
+    for (std::string_view column : schema.columns) {
+      if (name == column) return true;
+    }
+    if (ParseDouble(field.text)) any_number = true;
+  }
+  return !any_number;
+}
+
+std::optional<Header> ReadHeader(const CsvRecord& record, const Schema& schema, Diagnostics& diags) {
+  Header header;
+  header.field_of.resize(schema.columns.size());
+  header.field_count = record.fields.size();
+  bool ok = true;
+  std::vector<std::string> known(schema.columns.begin(), schema.columns.end());
+  for (std::size_t f = 0; f < record.fields.size(); ++f) {
+    const CsvField& field = record.fields[f];
+    std::string name = Lowercase(field.text);
+    auto it = std::find(schema.columns.begin(), schema.columns.end(), name);
+    if (it == schema.columns.end()) {
+      std::string closest = ClosestName(field.text, known);
+      diags.Report(DiagKind::CsvUnknownColumn, field.range, field.text,
+                   closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), schema.what,
+                   JoinColumns(schema, schema.columns.size()));
+      ok = false;
+      header.field_names.push_back("?");
+      continue;
+    }
+    std::size_t column = static_cast<std::size_t>(it - schema.columns.begin());
+    header.field_names.push_back(schema.columns[column]);
+    if (header.field_of[column]) {
+      diags.Report(DiagKind::CsvDuplicateColumn, field.range, schema.columns[column]);
+      ok = false;
+      continue;
+    }
+    header.field_of[column] = f;
+  }
+  for (std::size_t c = 0; c < schema.required; ++c) {
+    if (header.field_of[c]) continue;
+    diags.Report(DiagKind::CsvMissingColumn, SourceRange(SourceLoc{record.end.file, record.line, 1}),
+                 schema.columns[c], schema.what, JoinColumns(schema, schema.required));
+    ok = false;
+  }
+  if (!ok) return std::nullopt;
+  return header;
+}
+
+Header DefaultHeader(const Schema& schema) {
+  Header header;
+  for (std::size_t c = 0; c < schema.columns.size(); ++c) {
+    header.field_of.push_back(c < schema.required ? std::optional<std::size_t>(c) : std::nullopt);
+  }
+  header.field_count = schema.required;
+  header.field_names.assign(schema.columns.begin(), schema.columns.begin() + static_cast<long>(schema.required));
+  return header;
+}
+
+// One data row, read through the header. Each accessor reports its own
+// mistakes; `ok` turns false at the first one.
+class Row {
+ public:
+  Row(const CsvRecord& record, const Header& header, const Schema& schema, Diagnostics& diags)
+      : record_(record), header_(header), schema_(schema), diags_(diags) {}
+
+  // Checks the field count; false (reported) when it does not match.
+  bool CheckShape() {
+    std::size_t have = record_.fields.size(), want = header_.field_count;
+    if (have == want) return true;
+    if (have < want) {
+      std::string missing;
+      for (std::size_t f = have; f < want; ++f) {
+        missing += (missing.empty() ? "" : ", ") + std::string(header_.field_names[f]);
+      }
+      diags_.Report(DiagKind::CsvFieldCount, SourceRange(record_.end), have, want, "missing: " + missing);
+    } else {
+      diags_.Report(DiagKind::CsvFieldCount, record_.fields[want].range, have, want,
+                    "the first extra field is shown");
+    }
+    return false;
+  }
+
+  const CsvField* Field(std::size_t column) const {
+    const auto& index = header_.field_of[column];
+    return index ? &record_.fields[*index] : nullptr;
+  }
+  SourceRange Range(std::size_t column) const {
+    const CsvField* field = Field(column);
+    return field != nullptr ? field->range : SourceRange(record_.end);
+  }
+
+  std::optional<TableAxis> Axis(std::size_t column) {
+    const CsvField* field = Field(column);
+    if (!Present(column, field)) return std::nullopt;
+    std::string name = Lowercase(field->text);
+    if (name == "x") return TableAxis::X;
+    if (name == "y") return TableAxis::Y;
+    diags_.Report(DiagKind::TableBadAxis, field->range, field->text);
+    ok = false;
+    return std::nullopt;
+  }
+
+  // A finite number. `optional_column`: an empty or absent field is nullopt.
+  std::optional<double> Number(std::size_t column, bool optional_column = false) {
+    const CsvField* field = Field(column);
+    if (optional_column && (field == nullptr || field->text.empty())) return std::nullopt;
+    if (!Present(column, field)) return std::nullopt;
+    std::optional<double> value = ParseDouble(field->text);
+    if (!value) {
+      diags_.Report(DiagKind::CsvBadNumber, field->range, field->text, schema_.columns[column],
+                    NumberHint(field->text));
+      ok = false;
+      return std::nullopt;
+    }
+    if (!std::isfinite(*value)) {
+      diags_.Report(DiagKind::CsvNonFinite, field->range, field->text, schema_.columns[column]);
+      ok = false;
+      return std::nullopt;
+    }
+    return value;
+  }
+
+  // A whole number >= minimum.
+  std::optional<long long> Count(std::size_t column, long long minimum, bool optional_column = false) {
+    const CsvField* field = Field(column);
+    if (optional_column && (field == nullptr || field->text.empty())) return std::nullopt;
+    if (!Present(column, field)) return std::nullopt;
+    std::string_view text = field->text;
+    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+    long long value = 0;
+    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || value < minimum) {
+      diags_.Report(DiagKind::CsvBadCount, field->range, field->text, schema_.columns[column], minimum);
+      ok = false;
+      return std::nullopt;
+    }
+    return value;
+  }
+
+  bool ok = true;
+
+ private:
+  bool Present(std::size_t column, const CsvField* field) {
+    SMTCAL_CHECK(field != nullptr, "a required column without a field (the header check missed it)");
+    if (!field->text.empty()) return true;
+    diags_.Report(DiagKind::CsvEmptyField, field->range, schema_.columns[column]);
+    ok = false;
+    return false;
+  }
+
+  static std::string NumberHint(std::string_view text) {
+    if (text.find(',') != std::string_view::npos) return " (write the decimal point as '.')";
+    std::string lower = Lowercase(text);
+    for (std::string_view unit : {"mm", "um", "µm"}) {
+      if (lower.size() > unit.size() && lower.ends_with(unit)) return " (write the number without its unit)";
+    }
+    return "";
+  }
+
+  const CsvRecord& record_;
+  const Header& header_;
+  const Schema& schema_;
+  Diagnostics& diags_;
+};
+
+// Splits the file and reads its header. nullopt (reported) when the file has
+// no usable header or no rows; otherwise the header and the data records.
+struct Body {
+  Header header;
+  std::vector<CsvRecord> records;
+};
+
+std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnostics& diags) {
+  std::vector<CsvRecord> records = SplitCsv(file, diags);
+  const std::string& name = diags.sources().File(file).name;
+  if (records.empty()) {
+    if (!diags.has_errors()) {
+      diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), name);
+    }
+    return std::nullopt;
+  }
+  Body body;
+  if (LooksLikeHeader(records.front(), schema)) {
+    std::optional<Header> header = ReadHeader(records.front(), schema, diags);
+    if (!header) return std::nullopt;
+    body.header = std::move(*header);
+    records.erase(records.begin());
+  } else if (schema.header_optional) {
+    body.header = DefaultHeader(schema);
+  } else {
+    diags.Report(DiagKind::CsvMissingHeader, records.front().fields.front().range,
+                 JoinColumns(schema, schema.required));
+    return std::nullopt;
+  }
+  if (records.empty()) {
+    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), name);
+    return std::nullopt;
+  }
+  body.records = std::move(records);
+  return body;
+}
+
+}  // namespace
+
+std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
+  const SourceFile& source = diags.sources().File(file);
+  std::vector<CsvRecord> records;
+  const auto line_count = static_cast<std::uint32_t>(source.line_starts.size());
+  for (std::uint32_t number = 1; number <= line_count; ++number) {
+    std::string_view line = source.Line(number);
+    std::size_t start = 0;
+    if (number == 1 && line.starts_with("\xEF\xBB\xBF")) start = 3;  // UTF-8 byte order mark
+    std::size_t first = start;
+    while (first < line.size() && (IsBlank(line[first]) || line[first] == '\r')) ++first;
+    if (first == line.size() || line[first] == '#') continue;
+    CsvRecord record;
+    record.line = number;
+    record.end = At(file, number, line.size());
+    if (SplitLine(line, file, number, start, record, diags)) records.push_back(std::move(record));
+  }
+  return records;
+}
+
+std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags) {
+  enum { kAxis, kX, kY, kError, kStddev, kCount };
+  std::size_t errors_before = diags.error_count();
+  std::optional<Body> body = ReadBody(file, kTableSchema, diags);
+  if (!body) return std::nullopt;
+  std::vector<TableNode> nodes;
+  for (const CsvRecord& record : body->records) {
+    Row row(record, body->header, kTableSchema, diags);
+    if (!row.CheckShape()) continue;
+    TableNode node;
+    std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<double> x = row.Number(kX), y = row.Number(kY), error = row.Number(kError);
+    node.stddev_mm = row.Number(kStddev, true);
+    std::optional<long long> count = row.Count(kCount, 1, true);
+    if (!row.ok) continue;
+    if (node.stddev_mm && *node.stddev_mm < 0) {
+      diags.Report(DiagKind::TableNegativeStddev, row.Range(kStddev), row.Field(kStddev)->text);
+      continue;
+    }
+    node.axis = *axis;
+    node.x_mm = *x;
+    node.y_mm = *y;
+    node.error_mm = *error;
+    node.count = count ? static_cast<int>(std::min<long long>(*count, 1 << 30)) : 0;
+    node.x_field = row.Range(kX);
+    node.y_field = row.Range(kY);
+    node.error_field = row.Range(kError);
+    nodes.push_back(node);
+  }
+  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
+  return AssembleErrorTable(diags.sources().File(file).name, nodes, SourceLoc{file, 0, 0}, diags);
+}
+
+std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
+  enum { kAxis, kX, kY, kSet, kRepetition, kError };
+  std::size_t errors_before = diags.error_count();
+  std::optional<Body> body = ReadBody(file, kRawSchema, diags);
+  if (!body) return std::nullopt;
+  std::vector<RawMeasurement> measurements;
+  for (const CsvRecord& record : body->records) {
+    Row row(record, body->header, kRawSchema, diags);
+    if (!row.CheckShape()) continue;
+    std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<double> x = row.Number(kX), y = row.Number(kY);
+    std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
+    std::optional<double> error = row.Number(kError);
+    if (!row.ok) continue;
+    RawMeasurement m;
+    m.axis = *axis;
+    m.x_mm = *x;
+    m.y_mm = *y;
+    m.set = *set;
+    m.repetition = *repetition;
+    m.error_mm = *error;
+    m.x_field = row.Range(kX);
+    m.y_field = row.Range(kY);
+    m.repetition_field = row.Range(kRepetition);
+    m.error_field = row.Range(kError);
+    measurements.push_back(m);
+  }
+  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
+  return measurements;
+}
+
+std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics& diags) {
+  enum { kX, kY };
+  std::size_t errors_before = diags.error_count();
+  std::optional<Body> body = ReadBody(file, kPointSchema, diags);
+  if (!body) return std::nullopt;
+  std::vector<PointRow> points;
+  for (const CsvRecord& record : body->records) {
+    Row row(record, body->header, kPointSchema, diags);
+    if (!row.CheckShape()) continue;
+    std::optional<double> x = row.Number(kX), y = row.Number(kY);
+    if (!row.ok) continue;
+    SourceRange rx = row.Range(kX), ry = row.Range(kY);
+    std::uint32_t begin = std::min(rx.begin.column, ry.begin.column);
+    std::uint32_t end = std::max(rx.begin.column + rx.length, ry.begin.column + ry.length);
+    points.push_back({Eigen::Vector2d(*x, *y), SourceRange(SourceLoc{file, record.line, begin}, end - begin)});
+  }
+  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
+  return points;
+}
+
+}  // namespace smtcal

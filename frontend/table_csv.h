@@ -1,0 +1,59 @@
+// CSV files of the error tables (docs/error-tables.md): error tables, raw
+// measurements, and the point lists of `smtcal table forward|inverse`.
+//
+// The CSV dialect: fields separated by ',', optionally quoted with '"' ("" is
+// a quote inside a quoted field; a quoted field ends on its own line); LF or
+// CRLF line ends; an optional UTF-8 byte order mark; blank lines and lines
+// whose first non-blank character is '#' are skipped; spaces around fields are
+// ignored. The first line names the columns, in any order (the point lists may
+// leave it out: then the columns are x_mm,y_mm); a column smtcal does not know
+// is an error naming it. Numbers are read locale-independently ('.' decimal
+// point, optional exponent); nan and inf are rejected.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "frontend/diagnostics.h"
+#include "passes/error_table.h"
+#include "passes/error_table_build.h"
+
+namespace smtcal {
+
+struct CsvField {
+  std::string text;   // unquoted, spaces around it removed
+  SourceRange range;  // where it is in the file (an empty field: its position)
+};
+
+struct CsvRecord {
+  std::uint32_t line = 0;
+  std::vector<CsvField> fields;
+  SourceLoc end;  // just after the last character of the line
+};
+
+// Splits the file registered as `file` in diags.sources() into records,
+// skipping blank and comment lines. A line with a quoting error is reported
+// and left out.
+std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags);
+
+// An error table: axis,x_mm,y_mm,error_mm[,stddev_mm][,n], one row per node
+// and axis, rows in any order. Reports everything wrong with the rows and the
+// grid (AssembleErrorTable); nullopt when anything was an error. The table is
+// not validated yet (ValidateErrorTable).
+std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags);
+
+// Raw measurements: axis,x_mm,y_mm,set,repetition,error_mm.
+std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags);
+
+// A point list: x_mm,y_mm (the header may be left out).
+struct PointRow {
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+  SourceRange range;  // from the first to the last field of the row
+};
+std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics& diags);
+
+}  // namespace smtcal

@@ -1,0 +1,235 @@
+// Direct and inverse calibration (see inverse_calibration.h for the contract
+// and docs/error-tables.md for the derivations). Assumes a table that passed
+// ValidateErrorTable; guarantees |F(n) - a| <= kInverseResidualTolMm within
+// IterationBound() iterations for the default solver, and a named status (never
+// a NaN) for every finite input point.
+#include "passes/inverse_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/LU>
+
+#include "frontend/check.h"
+
+namespace smtcal {
+
+std::string_view StatusName(SolveStatus status) {
+  switch (status) {
+    case SolveStatus::kOk: return "ok";
+    case SolveStatus::kClamped: return "clamped";
+    case SolveStatus::kUncorrected: return "uncorrected";
+    case SolveStatus::kOutside: return "outside";
+    case SolveStatus::kNotConverged: return "not-converged";
+  }
+  return "ok";
+}
+
+namespace {
+
+double InfNorm(const Eigen::Vector2d& v) { return std::max(std::abs(v.x()), std::abs(v.y())); }
+
+void CheckSolvable(const TableAnalysis& analysis) {
+  SMTCAL_CHECK(analysis.contraction <= kMaxErrorSlope && analysis.min_jacobian_det >= kMinJacobianDet,
+               "an inverse solver needs a table that passed ValidateErrorTable");
+}
+
+// Applies the outside policy to a solved (or directly calibrated) point.
+Solution ApplyPolicy(const CalibrationMap& map, Solution solution, const Eigen::Vector2d& nominal,
+                     const Eigen::Vector2d& input, OutsidePolicy policy) {
+  if (solution.status == SolveStatus::kNotConverged || map.Inside(nominal)) return solution;
+  switch (policy) {
+    case OutsidePolicy::kError:
+      solution.status = SolveStatus::kOutside;
+      break;
+    case OutsidePolicy::kClamp:
+      solution.status = SolveStatus::kClamped;
+      break;
+    case OutsidePolicy::kNone:
+      solution = Solution{input, 0, 0, SolveStatus::kUncorrected};
+      break;
+  }
+  return solution;
+}
+
+}  // namespace
+
+Solution DirectCalibrate(const CalibrationMap& map, const Eigen::Vector2d& n, OutsidePolicy policy) {
+  SMTCAL_CHECK(std::isfinite(n.x()) && std::isfinite(n.y()), "calibrating a non-finite point");
+  Solution solution{n + map.Delta(n), 0, 0, SolveStatus::kOk};
+  return ApplyPolicy(map, solution, n, n, policy);
+}
+
+int IterationBound(double contraction, double max_abs_error_mm) {
+  SMTCAL_CHECK(contraction >= 0 && contraction < 1 && max_abs_error_mm >= 0,
+               "IterationBound needs a contraction factor below 1");
+  const double target = kInverseResidualTolMm / 2;
+  const double start = std::sqrt(2.0) * max_abs_error_mm;  // |r_0|_2 <= sqrt(2) |Delta|_inf
+  if (start <= target) return 0;
+  if (contraction == 0) return 1;  // a constant Delta: one step is exact
+  return static_cast<int>(std::ceil(std::log(target / start) / std::log(contraction)));
+}
+
+int IterationBound(const ErrorTable& table) {
+  TableAnalysis analysis = AnalyzeTable(table);
+  CheckSolvable(analysis);
+  return IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+}
+
+// ------------------------------------------------------------------ default solver
+
+InverseSolver::InverseSolver(const ErrorTable& table) : InverseSolver(table, AnalyzeTable(table)) {}
+
+InverseSolver::InverseSolver(const ErrorTable& table, const TableAnalysis& analysis)
+    : map_(table), contraction_(analysis.contraction) {
+  CheckSolvable(analysis);
+  iteration_bound_ = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+}
+
+Solution InverseSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const {
+  SMTCAL_CHECK(std::isfinite(actual.x()) && std::isfinite(actual.y()), "solving for a non-finite point");
+  Eigen::Vector2d n = actual;
+  Eigen::Vector2d delta;
+  Eigen::Matrix2d jacobian;
+  map_.DeltaAndJacobian(n, delta, jacobian);
+  Eigen::Vector2d residual = n + delta - actual;
+  int iterations = 0;
+  while (residual.norm() > kInverseResidualTolMm) {
+    if (iterations == iteration_bound_) break;
+    ++iterations;
+    // Newton: solve (I + J) step = residual. In a valid table det >= 1/2
+    // inside and >= 1 - L outside (a clamped coordinate has zero slope).
+    const double a = 1 + jacobian(0, 0), b = jacobian(0, 1), c = jacobian(1, 0), d = 1 + jacobian(1, 1);
+    const double det = a * d - b * c;
+    bool accepted = false;
+    if (det > 0) {
+      Eigen::Vector2d trial(n.x() - (d * residual.x() - b * residual.y()) / det,
+                            n.y() - (a * residual.y() - c * residual.x()) / det);
+      Eigen::Vector2d trial_delta;
+      Eigen::Matrix2d trial_jacobian;
+      map_.DeltaAndJacobian(trial, trial_delta, trial_jacobian);
+      Eigen::Vector2d trial_residual = trial + trial_delta - actual;
+      // Keep it only if it does at least as well as the fixed-point step is
+      // guaranteed to (across a cell boundary the Jacobian jumps).
+      if (InfNorm(trial_residual) <= contraction_ * InfNorm(residual)) {
+        n = trial;
+        delta = trial_delta;
+        jacobian = trial_jacobian;
+        residual = trial_residual;
+        accepted = true;
+      }
+    }
+    if (!accepted) {
+      n = actual - delta;  // the fixed-point step: |r| shrinks by L at least
+      map_.DeltaAndJacobian(n, delta, jacobian);
+      residual = n + delta - actual;
+    }
+  }
+  Solution solution{n, residual.norm(), iterations, SolveStatus::kOk};
+  if (solution.residual_mm > kInverseResidualTolMm) solution.status = SolveStatus::kNotConverged;
+  return ApplyPolicy(map_, solution, n, actual, policy);
+}
+
+// ------------------------------------------------------------------ the paper's solver
+
+PaperSolver::PaperSolver(const ErrorTable& table, double tolerance_mm, int max_steps)
+    : map_(table), tolerance_mm_(tolerance_mm), max_steps_(max_steps) {
+  CheckSolvable(AnalyzeTable(table));
+  SMTCAL_CHECK(tolerance_mm > 0 && max_steps >= 2, "the paper's solver needs a tolerance and 2 steps");
+}
+
+// The discrete function x_N(x_N + Delta-x, y_N) on the row at nominal y: the
+// row's nodes map nominal x_i to actual x_i + Delta-x(x_i, y) (between grid
+// rows Delta-x is interpolated linearly along each column), and the actual x
+// is inverted by linear interpolation between neighbouring nodes. Beyond the
+// row's ends the edge value of Delta-x is used (slope 1), the same extension
+// as the direct calibration's.
+double PaperSolver::NominalXOnRow(double actual_x, double y) const {
+  const std::vector<double>& xs = map_.xs(TableAxis::X);
+  double previous = xs[0] + map_.AxisDelta(TableAxis::X, xs[0], y);
+  if (actual_x <= previous) return xs[0] + (actual_x - previous);
+  for (std::size_t i = 1; i < xs.size(); ++i) {
+    double here = xs[i] + map_.AxisDelta(TableAxis::X, xs[i], y);
+    if (actual_x <= here) {
+      return xs[i - 1] + (actual_x - previous) / (here - previous) * (xs[i] - xs[i - 1]);
+    }
+    previous = here;
+  }
+  return xs.back() + (actual_x - previous);
+}
+
+// y_N(x_N, y_N + Delta-y) on the column at nominal x, as above.
+double PaperSolver::NominalYOnColumn(double actual_y, double x) const {
+  const std::vector<double>& ys = map_.ys(TableAxis::Y);
+  double previous = ys[0] + map_.AxisDelta(TableAxis::Y, x, ys[0]);
+  if (actual_y <= previous) return ys[0] + (actual_y - previous);
+  for (std::size_t j = 1; j < ys.size(); ++j) {
+    double here = ys[j] + map_.AxisDelta(TableAxis::Y, x, ys[j]);
+    if (actual_y <= here) {
+      return ys[j - 1] + (actual_y - previous) / (here - previous) * (ys[j] - ys[j - 1]);
+    }
+    previous = here;
+  }
+  return ys.back() + (actual_y - previous);
+}
+
+// The interval of nominal x that gives the actual x on the rows within the
+// nominal y interval: the rows at both ends and every grid row inside.
+PaperSolver::Interval PaperSolver::StepX(double actual_x, Interval y) const {
+  double first = NominalXOnRow(actual_x, y.lo);
+  Interval x{first, first};
+  auto include = [&](double row_y) {
+    double v = NominalXOnRow(actual_x, row_y);
+    x.lo = std::min(x.lo, v);
+    x.hi = std::max(x.hi, v);
+  };
+  include(y.hi);
+  for (double row_y : map_.ys(TableAxis::X)) {
+    if (row_y > y.lo && row_y < y.hi) include(row_y);
+  }
+  return x;
+}
+
+PaperSolver::Interval PaperSolver::StepY(double actual_y, Interval x) const {
+  double first = NominalYOnColumn(actual_y, x.lo);
+  Interval y{first, first};
+  auto include = [&](double column_x) {
+    double v = NominalYOnColumn(actual_y, column_x);
+    y.lo = std::min(y.lo, v);
+    y.hi = std::max(y.hi, v);
+  };
+  include(x.hi);
+  for (double column_x : map_.xs(TableAxis::Y)) {
+    if (column_x > x.lo && column_x < x.hi) include(column_x);
+  }
+  return y;
+}
+
+Solution PaperSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const {
+  SMTCAL_CHECK(std::isfinite(actual.x()) && std::isfinite(actual.y()), "solving for a non-finite point");
+  const std::vector<double>& rows = map_.ys(TableAxis::X);
+  // Step 1: all nominal rows. Step 2: y within the x interval found.
+  Interval x = StepX(actual.x(), Interval{rows.front(), rows.back()});
+  Interval y = StepY(actual.y(), x);
+  int steps = 2;
+  Eigen::Vector2d n;
+  double residual = 0;
+  while (true) {
+    // After every step from the second: the interval means, corrected
+    // through the tables, compared with the required position.
+    n = {0.5 * (x.lo + x.hi), 0.5 * (y.lo + y.hi)};
+    residual = (n + map_.Delta(n) - actual).norm();
+    if (residual <= tolerance_mm_ || steps >= max_steps_) break;
+    ++steps;
+    if (steps % 2 == 1) {
+      x = StepX(actual.x(), y);
+    } else {
+      y = StepY(actual.y(), x);
+    }
+  }
+  Solution solution{n, residual, steps, SolveStatus::kOk};
+  if (residual > tolerance_mm_) solution.status = SolveStatus::kNotConverged;
+  return ApplyPolicy(map_, solution, n, actual, policy);
+}
+
+}  // namespace smtcal

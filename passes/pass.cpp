@@ -1,0 +1,104 @@
+// The pass registry and the pass runner.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "passes/checks.h"
+#include "passes/pass.h"
+#include "passes/pass_manager.h"
+#include "passes/verifier.h"
+
+namespace smtcal {
+
+const std::vector<PassInfo>& PassRegistry() {
+  // The default pipeline, in order: names before anything that resolves
+  // them, so a user reading the output top-down sees causes first.
+  static const std::vector<PassInfo> registry = {
+      {"check-header", "Program first and once, Units mm once, a Function Main exists",
+       CreateCheckHeaderPass},
+      {"check-names", "names defined once and used as the right kind; Local frames do not loop",
+       CreateCheckNamesPass},
+      {"check-types", "Integer/Real/Boolean expressions, conditions, assignments, For/Next",
+       CreateCheckTypesPass},
+      {"check-ranges", "I/O bits, vacuum outputs, pallets, steps, waits, angles and LimZ within limits",
+       CreateCheckRangesPass},
+      {"check-fixture-scope", "fixture points used only inside a Cycle of their fixture, across Calls",
+       CreateCheckFixtureScopePass},
+      {"check-reachability", "unreachable statements, functions never called, recursion",
+       CreateCheckReachabilityPass},
+  };
+  return registry;
+}
+
+Result<std::vector<const PassInfo*>> FindPasses(const std::vector<std::string>& names) {
+  const std::vector<PassInfo>& registry = PassRegistry();
+  std::vector<const PassInfo*> found;
+  for (const std::string& name : names) {
+    auto it = std::find_if(registry.begin(), registry.end(),
+                           [&](const PassInfo& info) { return info.name == name; });
+    if (it == registry.end()) {
+      std::vector<std::string> valid;
+      for (const PassInfo& info : registry) valid.push_back(info.name);
+      return Error{fmt::format("unknown pass '{}'; valid passes: {}", name, fmt::join(valid, ", "))};
+    }
+    found.push_back(&*it);
+  }
+  return found;
+}
+
+namespace {
+
+void VerifyOrAbort(const ir::Program& program, const Diagnostics& diags, std::string_view culprit) {
+  std::vector<VerifierIssue> issues = VerifyProgram(program);
+  if (issues.empty()) return;
+  std::string report = fmt::format(
+      "smtcal: internal error: the IR is broken {} ({} problem{}); this is a bug in smtcal, not "
+      "in the program:\n",
+      culprit, issues.size(), issues.size() == 1 ? "" : "s");
+  for (const VerifierIssue& issue : issues) {
+    report += fmt::format("  {}\n", FormatVerifierIssue(issue, diags.sources(), program.file));
+  }
+  std::fputs(report.c_str(), stderr);
+  std::fflush(stderr);
+  std::abort();
+}
+
+}  // namespace
+
+Status RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<std::string>& names,
+                 bool verify_each) {
+  std::vector<const PassInfo*> passes;
+  if (names.empty()) {
+    for (const PassInfo& info : PassRegistry()) passes.push_back(&info);
+  } else {
+    Result<std::vector<const PassInfo*>> found = FindPasses(names);
+    if (!found) return found.error();
+    passes = std::move(found).value();
+  }
+  RunPasses(program, diags, passes, verify_each);
+  return Ok{};
+}
+
+void RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<const PassInfo*>& passes,
+               bool verify_each) {
+  if (verify_each) VerifyOrAbort(program, diags, "in the input to the first pass");
+  for (const PassInfo* info : passes) {
+    std::unique_ptr<Pass> pass = info->create();
+    pass->Run(program, diags);
+    if (verify_each) VerifyOrAbort(program, diags, fmt::format("after pass '{}'", info->name));
+  }
+}
+
+std::string DescribePasses() {
+  std::size_t width = 0;
+  for (const PassInfo& info : PassRegistry()) width = std::max(width, info.name.size());
+  std::string text;
+  for (const PassInfo& info : PassRegistry()) {
+    text += fmt::format("  {:<{}}  {}\n", info.name, width, info.description);
+  }
+  return text;
+}
+
+}  // namespace smtcal

@@ -1,0 +1,59 @@
+// Tolerances and safety margins: one named constant per quantity, the unit in
+// the name (Mm = millimetres; plain numbers are dimensionless). Each area keeps
+// its constants in its own section with a comment on why the value is what it
+// is. Limits of the language and the controller live in limits.h instead.
+#pragma once
+
+namespace smtcal {
+
+// --- error tables and inverse calibration ------------------------------------
+// (passes/error_table*.cpp, passes/inverse_calibration.cpp; docs/error-tables.md)
+
+// The residual |F(n) - a| that the default inverse solver reaches for every
+// point inside a valid table (DESIGN.md, "Numbers"). The iteration bound of a
+// table is derived for half of it, which leaves room for rounding.
+inline constexpr double kInverseResidualTolMm = 1e-9;
+
+// The paper's solver stops when the direct-calibrated interval means are this
+// close to the required point: the task tolerance of the basic assembly
+// operation, here a hundredth of the paper's +-0.1 mm placing tolerance.
+inline constexpr double kPaperSolverTolMm = 0.001;
+// ... or after this many interval steps, whichever comes first.
+inline constexpr int kPaperSolverMaxSteps = 60;
+
+// A table must not fold: det(I + grad(Delta)) stays at or above this in every
+// cell. A real robot's error changes by micrometres per millimetre (det near
+// 1); anything near 0 is a sign or unit blunder in the measurements.
+inline constexpr double kMinJacobianDet = 0.5;
+// ... and the error must change slowly: the contraction factor
+// L = max |grad(Delta)|_inf stays at or below this. L < 1 is what makes the
+// fixed-point step of the inverse solver contract (and the iteration bound
+// finite); 0.5 keeps that bound small and is still 100x a real robot's slope.
+inline constexpr double kMaxErrorSlope = 0.5;
+
+// Grid lines of one axis table closer than this are the same line written two
+// ways (a rounding difference between measurement sessions), not a grid.
+inline constexpr double kMinGridLineSpacingMm = 0.01;
+
+// A point this close outside the table's rectangle still counts as inside, so
+// a solution that lands on the edge up to rounding is not called "outside".
+inline constexpr double kTableEdgeTolMm = 1e-9;
+
+// The paper's condition for linear interpolation is checked as a warning: an
+// error larger than this fraction of the grid pitch around its node is more
+// likely micrometres written as millimetres than a real robot error.
+inline constexpr double kMaxErrorPitchFraction = 0.5;
+
+// `table build` flags a node whose repetition scatter (pooled stddev) is above
+// median + kNoisyNodeMadFactor * 1.4826 * MAD of its axis's nodes (a robust
+// 5-sigma) and at least kNoisyNodeFloorMm (the transducers' resolution) above
+// the median, so a table of perfectly repeatable nodes does not flag noise.
+inline constexpr double kNoisyNodeMadFactor = 5.0;
+inline constexpr double kNoisyNodeFloorMm = 0.001;
+// ... and a node whose set means differ by more than kSetShiftFactor standard
+// errors of that difference (from the repetition scatter) and by more than
+// kSetShiftFloorMm: the robot or the fixture moved between the sets.
+inline constexpr double kSetShiftFactor = 6.0;
+inline constexpr double kSetShiftFloorMm = 0.001;
+
+}  // namespace smtcal
