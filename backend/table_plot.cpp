@@ -109,7 +109,8 @@ struct Panel {
 };
 
 double Bilinear(const AxisTable& t, std::size_t i, std::size_t j, double s, double u) {
-  return (1 - u) * ((1 - s) * t.At(i, j) + s * t.At(i + 1, j)) + u * ((1 - s) * t.At(i, j + 1) + s * t.At(i + 1, j + 1));
+  return (1 - u) * ((1 - s) * t.At(i, j) + s * t.At(i + 1, j)) +
+         u * ((1 - s) * t.At(i, j + 1) + s * t.At(i + 1, j + 1));
 }
 
 void DrawColourMap(std::string& svg, const Panel& p, double range_mm) {

@@ -22,13 +22,10 @@
 
 #include <algorithm>
 #include <charconv>
-#include <climits>
-#include <cstdio>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -37,7 +34,8 @@
 
 #include <fmt/format.h>
 
-// ANTLR's headers #undef the EOF macro of <cstdio>; they come last.
+// ANTLR's headers #undef the EOF macro of <cstdio>; they come after every
+// standard header that might include it.
 #include "PlaceBaseVisitor.h"
 #include "PlaceLexer.h"
 #include "PlaceParser.h"
@@ -112,7 +110,7 @@ std::string_view Spelling(std::size_t type) {
 }
 
 // An entry of an "expected ..." list.
-std::string ExpectedName(std::size_t type) {
+std::string ExpectedItem(std::size_t type) {
   if (type == Token::EOF) return "end of file";
   if (type == P::NEWLINE) return "end of line";
   if (type == P::ID) return "a name";
@@ -183,6 +181,21 @@ struct OpenBlock {
   bool seen_else = false;
 };
 
+std::size_t CloserOf(std::size_t opener) {
+  switch (opener) {
+    case P::FUNCTION: return P::FEND;
+    case P::FOR: return P::NEXT;
+    case P::IF: return P::ENDIF;
+    default: return P::ENDCYCLE;
+  }
+}
+
+// "Function Main", "the For": how messages name an open block.
+std::string Describe(const OpenBlock& open) {
+  if (open.type != P::FUNCTION) return fmt::format("the {}", Spelling(open.type));
+  return open.name.empty() ? "the Function" : "Function " + open.name;
+}
+
 class Session {
  public:
   Session(std::uint32_t file, Diagnostics& diags)
@@ -214,9 +227,17 @@ class Session {
   }
 
   // --- errors
+  // Records an error for Flush(); the line it points at counts as broken
+  // (one error per line, and the builder drops that line's statement).
   template <typename... Args>
   PendingError& Error(DiagKind kind, SourceRange range, Args... args) {
     if (range.begin.line < lines_.size()) lines_[range.begin.line].error = true;
+    return ErrorElsewhere(kind, range, args...);
+  }
+  // The same for an error that points at a line that is not broken itself
+  // (the opener of a block that is never closed).
+  template <typename... Args>
+  PendingError& ErrorElsewhere(DiagKind kind, SourceRange range, Args... args) {
     errors_.push_back({range.begin, [=](Diagnostics& d) { return d.Report(kind, range, args...); }, {}});
     return errors_.back();
   }
@@ -233,11 +254,12 @@ class Session {
                         const antlr4::misc::IntervalSet& expected, bool deep);
 
  private:
-  void Lex();
+  void Lex(antlr4::ANTLRErrorListener& listener);
   void PreScan();
   void CheckCharacters(Line& line);
   void CheckExpressionSize(Line& line);
   void CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& misplaced_run);
+  bool IfHasBlock(std::size_t if_line) const;
   void CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, Line& line, Token* at, bool quiet);
   // Error(), unless the line already has one: one error per line.
   template <typename... Args>
@@ -245,6 +267,7 @@ class Session {
     if (!line.error) Error(kind, range, args...);
   }
   void Drop(Line& line) { line.code.clear(); line.error = true; }
+  void CloseAtEndOfFile(std::vector<OpenBlock>& stack, bool report);
   std::unique_ptr<Token> MakeToken(std::size_t type, const Token* at);
   std::vector<std::unique_ptr<Token>> ParserTokens();
   void Flush();
@@ -263,13 +286,18 @@ class Session {
 
 // ------------------------------------------------------------------ step 1: lex
 
-void Session::Lex() {
+void Session::Lex(antlr4::ANTLRErrorListener& listener) {
   stream_ = std::make_unique<ByteStream>(text_);
   lexer_ = std::make_unique<PlaceLexer>(stream_.get());
-  lexer_->removeErrorListeners();  // BAD_CHAR takes every byte; nothing to report
+  // BAD_CHAR takes any byte no other token does, so the lexer has nothing to
+  // report; should it ever, the message goes through our listener.
+  lexer_->removeErrorListeners();
+  lexer_->addErrorListener(&listener);
   for (;;) {
     std::unique_ptr<Token> token = lexer_->nextToken();
     bool eof = token->getType() == Token::EOF;
+    // Remember each token's place in lexed_, so ParserTokens() can move it.
+    static_cast<antlr4::CommonToken*>(token.get())->setTokenIndex(lexed_.size());
     lexed_.push_back(std::move(token));
     if (eof) break;
   }
@@ -300,37 +328,27 @@ void Session::PreScan() {
     CheckStructure(line, stack, misplaced_run);
     CheckExpressionSize(line);
     if (stack.size() > kMaxBlockDepth) {
+      // Stop here: drop this line and the rest, close what is open silently.
       Error(DiagKind::BlocksTooDeep, Range(stack.back().opener), kMaxBlockDepth);
       for (std::size_t rest = n + 1; rest < lines_.size(); ++rest) lines_[rest].code.clear();
       stack.pop_back();
       Drop(line);
-      while (!stack.empty()) {  // close silently: the error above says enough
-        Token* opener = stack.back().opener;
-        std::size_t closer = stack.back().type == P::FUNCTION ? P::FEND
-                             : stack.back().type == P::FOR    ? P::NEXT
-                             : stack.back().type == P::IF     ? P::ENDIF
-                                                              : P::ENDCYCLE;
-        tail_.push_back(MakeToken(P::NEWLINE, opener));
-        tail_.push_back(MakeToken(closer, opener));
-        stack.pop_back();
-      }
-      tail_.push_back(MakeToken(P::NEWLINE, lexed_.back().get()));
-      return;
+      return CloseAtEndOfFile(stack, false);
     }
   }
-  // Blocks still open at the end of the file.
+  CloseAtEndOfFile(stack, true);
+}
+
+// Closes the blocks still open at the end of the file, innermost first.
+void Session::CloseAtEndOfFile(std::vector<OpenBlock>& stack, bool report) {
   const Token* eof = lexed_.back().get();
   while (!stack.empty()) {
     const OpenBlock& open = stack.back();
-    std::string what = open.type == P::FUNCTION
-                           ? (open.name.empty() ? "the Function" : "Function " + open.name)
-                           : fmt::format("the {}", Spelling(open.type));
-    std::size_t closer = open.type == P::FUNCTION ? P::FEND
-                         : open.type == P::FOR    ? P::NEXT
-                         : open.type == P::IF     ? P::ENDIF
-                                                  : P::ENDCYCLE;
-    Error(DiagKind::MissingBlockEndAtEof, Range(open.opener), std::string(Spelling(closer)), what,
-          open.opener->getLine());
+    std::size_t closer = CloserOf(open.type);
+    if (report) {
+      ErrorElsewhere(DiagKind::MissingBlockEndAtEof, Range(open.opener), std::string(Spelling(closer)),
+                     Describe(open), open.opener->getLine());
+    }
     tail_.push_back(MakeToken(P::NEWLINE, eof));
     tail_.push_back(MakeToken(closer, eof));
     stack.pop_back();
@@ -369,7 +387,7 @@ void Session::CheckCharacters(Line& line) {
     } else if (valid_utf8 && byte >= 0x80) {
       bytes = static_cast<std::uint32_t>(length);
       what = fmt::format("'{}'", text_.substr(at, length));
-      hint = "; names use only the letters A-Z, digits and '_'";
+      hint = "; outside comments a program uses only plain ASCII letters, digits and signs";
     } else {
       what = fmt::format("with byte value 0x{:02X}", byte);
       hint = byte >= 0x80 ? "; the file is not UTF-8 text" : "";
@@ -395,9 +413,11 @@ void Session::CheckExpressionSize(Line& line) {
 }
 
 std::unique_ptr<Token> Session::MakeToken(std::size_t type, const Token* at) {
-  auto token = std::make_unique<antlr4::CommonToken>(
-      std::make_pair(static_cast<antlr4::TokenSource*>(lexer_.get()), static_cast<antlr4::CharStream*>(stream_.get())),
-      type, Token::DEFAULT_CHANNEL, at->getStartIndex(), at->getStartIndex());
+  // A real source: ANTLR's recovery asks a token for its source when it
+  // conjures a missing token next to it.
+  std::pair<antlr4::TokenSource*, antlr4::CharStream*> source(lexer_.get(), stream_.get());
+  auto token = std::make_unique<antlr4::CommonToken>(source, type, Token::DEFAULT_CHANNEL, at->getStartIndex(),
+                                                     at->getStartIndex());
   token->setLine(at->getLine());
   token->setCharPositionInLine(at->getCharPositionInLine());
   token->setText(std::string(type == P::NEWLINE ? "\n" : Spelling(type)));
@@ -409,13 +429,8 @@ void Session::CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, 
                                bool quiet) {
   while (stack.size() > keep) {
     const OpenBlock& open = stack.back();
-    std::size_t closer = open.type == P::FUNCTION ? P::FEND
-                         : open.type == P::FOR    ? P::NEXT
-                         : open.type == P::IF     ? P::ENDIF
-                                                  : P::ENDCYCLE;
-    std::string what = open.type == P::FUNCTION
-                           ? (open.name.empty() ? "the Function" : "Function " + open.name)
-                           : fmt::format("the {}", Spelling(open.type));
+    std::size_t closer = CloserOf(open.type);
+    std::string what = Describe(open);
     if (!quiet) {
       PendingError& error = Error(DiagKind::MissingBlockEnd, Range(at), std::string(Spelling(closer)), what,
                                   open.opener->getLine());
@@ -432,7 +447,7 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
   Token* first = line.code.front();
   std::size_t type = first->getType();
   bool quiet = line.error;  // a bad character was reported on this line
-  std::size_t second = line.code.size() > 1 ? line.code[1]->getType() : static_cast<std::size_t>(P::NEWLINE);
+  std::size_t second = line.code.size() > 1 ? line.code[1]->getType() : std::size_t{P::NEWLINE};
   auto innermost = [&](std::size_t block_type) -> std::ptrdiff_t {
     for (std::size_t i = stack.size(); i-- > 0;) {
       if (stack[i].type == block_type) return static_cast<std::ptrdiff_t>(i);
@@ -451,6 +466,10 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     }
     return nullptr;
   };
+  auto cut_after = [&](Token* token) {
+    auto end = std::find(line.code.begin(), line.code.end(), token) + 1;
+    line.code.erase(end, line.code.end());
+  };
 
   switch (type) {
     case P::FUNCTION: {
@@ -464,9 +483,12 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     case P::IF:
     case P::CYCLE:
       if (stack.empty()) return misplaced(fmt::format("'{}'", Spelling(type)));
-      if (type == P::IF && then_not_last() != nullptr) {
-        LineError(line, DiagKind::SingleLineIf, Range(then_not_last()), "Then");
-        return Drop(line);
+      if (Token* then = type == P::IF ? then_not_last() : nullptr) {
+        LineError(line, DiagKind::SingleLineIf, Range(then), "Then");
+        // A block If with something after Then keeps its header; a SPEL
+        // single-line If (no EndIf follows) opens no block.
+        if (!IfHasBlock(then->getLine())) return Drop(line);
+        cut_after(then);
       }
       stack.push_back({type, first, {}, false});
       return;
@@ -481,13 +503,13 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
       CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, line, first, quiet);
       if (stack.back().seen_else) {
         LineError(line, DiagKind::ElseAfterElse, Range(first), std::string(Spelling(type)),
-              stack.back().opener->getLine());
+                  stack.back().opener->getLine());
         return Drop(line);
       }
       if (type == P::ELSE) stack.back().seen_else = true;
-      if (type == P::ELSEIF && then_not_last() != nullptr) {
-        LineError(line, DiagKind::SingleLineIf, Range(then_not_last()), "Then");
-        return Drop(line);
+      if (Token* then = type == P::ELSEIF ? then_not_last() : nullptr) {
+        LineError(line, DiagKind::SingleLineIf, Range(then), "Then");
+        cut_after(then);
       }
       return;
     }
@@ -496,11 +518,14 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     case P::ENDCYCLE:
     case P::FEND: {
       if (stack.empty() && misplaced_run) return Drop(line);
-      std::size_t opener = type == P::NEXT ? P::FOR : type == P::ENDIF ? P::IF : type == P::ENDCYCLE ? P::CYCLE : P::FUNCTION;
+      std::size_t opener = type == P::NEXT    ? P::FOR
+                           : type == P::ENDIF ? P::IF
+                           : type == P::ENDCYCLE ? P::CYCLE
+                                                 : P::FUNCTION;
       std::ptrdiff_t at = innermost(opener);
       if (at < 0) {
         LineError(line, DiagKind::UnexpectedBlockEnd, Range(first), std::string(Spelling(type)),
-              std::string(Spelling(opener)));
+                  std::string(Spelling(opener)));
         return Drop(line);
       }
       CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, line, first, quiet);
@@ -517,8 +542,8 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     case P::VACUUM:
       if (!stack.empty()) {
         std::string_view kind = type == P::TAUGHT ? "Taught Point" : Spelling(type);
-        std::string function = stack.front().name.empty() ? "..." : stack.front().name;
-        LineError(line, DiagKind::DeclarationInsideFunction, Range(first), std::string(kind), function);
+        LineError(line, DiagKind::DeclarationInsideFunction, Range(first), std::string(kind),
+                  Describe(stack.front()));
         return Drop(line);
       }
       misplaced_run = false;
@@ -533,12 +558,12 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
         std::string suggestion = ClosestName(Text(first), words);
         if (stack.empty()) {
           LineError(line, DiagKind::ExpectedDeclaration, Range(first), Display(first),
-                suggestion.empty() ? std::string() : fmt::format("; did you mean '{}'?", suggestion));
+                    suggestion.empty() ? std::string() : fmt::format("; did you mean '{}'?", suggestion));
           return Drop(line);
         }
         if (!suggestion.empty()) {
           LineError(line, DiagKind::ExpectedStatement, Range(first), Display(first),
-                fmt::format("; did you mean '{}'?", suggestion));
+                    fmt::format("; did you mean '{}'?", suggestion));
           return Drop(line);
         }
         return;  // ANTLR says what is wrong with it
@@ -559,20 +584,59 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
   }
 }
 
+// Whether the If on if_line is a block: an ElseIf, Else or EndIf of its own
+// follows before the block around it closes. Past the error limit nothing
+// more is shown, so the answer no longer matters and the scan is skipped
+// (which keeps a file of single-line Ifs from costing quadratic time).
+bool Session::IfHasBlock(std::size_t if_line) const {
+  if (errors_.size() > kMaxSyntaxErrors) return false;
+  int depth = 0;
+  for (std::size_t n = if_line + 1; n < lines_.size(); ++n) {
+    if (lines_[n].code.empty()) continue;
+    switch (lines_[n].code.front()->getType()) {
+      case P::FOR: case P::CYCLE: ++depth; break;
+      case P::IF: {
+        const std::vector<Token*>& code = lines_[n].code;
+        if (code.back()->getType() == P::THEN) ++depth;
+        break;
+      }
+      case P::ELSEIF: case P::ELSE:
+        if (depth == 0) return true;
+        break;
+      case P::ENDIF:
+        if (depth == 0) return true;
+        --depth;
+        break;
+      case P::NEXT: case P::ENDCYCLE:
+        if (depth == 0) return false;
+        --depth;
+        break;
+      case P::FEND: case P::FUNCTION:
+        return false;
+      default:
+        break;
+    }
+  }
+  return false;
+}
+
 // The token list ANTLR parses: the kept code of each line, the closers the
-// pre-scan inserted, the NEWLINEs and EOF. Copies, so the lexer's tokens
-// (comments included) stay where the builder can look them up.
+// pre-scan inserted, the NEWLINEs and EOF. The tokens move out of lexed_;
+// the objects stay put, so Line's pointers (and the comments, which stay in
+// lexed_) remain valid.
 std::vector<std::unique_ptr<Token>> Session::ParserTokens() {
   std::vector<std::unique_ptr<Token>> out;
+  const Token* eof = lexed_.back().get();  // never moved: no line holds it
+  auto take = [&](Token* token) { out.push_back(std::move(lexed_[token->getTokenIndex()])); };
   for (Line& line : lines_) {
     for (auto& token : line.insert_before) out.push_back(std::move(token));
-    for (Token* token : line.code) out.push_back(std::make_unique<antlr4::CommonToken>(token));
-    if (line.newline != nullptr) out.push_back(std::make_unique<antlr4::CommonToken>(line.newline));
+    for (Token* token : line.code) take(token);
+    if (line.newline != nullptr) take(line.newline);
   }
   // The grammar wants every line to end in NEWLINE (see Place.g4).
-  if (out.empty() || out.back()->getType() != P::NEWLINE) out.push_back(MakeToken(P::NEWLINE, lexed_.back().get()));
+  if (out.empty() || out.back()->getType() != P::NEWLINE) out.push_back(MakeToken(P::NEWLINE, eof));
   for (auto& token : tail_) out.push_back(std::move(token));
-  out.push_back(std::make_unique<antlr4::CommonToken>(lexed_.back().get()));
+  out.push_back(MakeToken(Token::EOF, eof));
   return out;
 }
 
@@ -715,6 +779,7 @@ std::string FormHint(antlr4::RuleContext* ctx) {
     if (dynamic_cast<P::SwitchExprContext*>(c)) return "; write: Sw(n)";
     if (dynamic_cast<P::OffsetContext*>(c)) return "; write: + X(d)";
     if (dynamic_cast<P::ExitStmtContext*>(c)) return "; write: Exit Function";
+    if (dynamic_cast<P::AssignmentContext*>(c)) return "; write: name = value";
     if (dynamic_cast<P::BlockContext*>(c) || dynamic_cast<P::ProgramContext*>(c)) break;
   }
   return "";
@@ -795,12 +860,15 @@ void Session::ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext
   }
   // The expected tokens in words; operators only when nothing else fits.
   std::vector<std::string> names;
+  // An expression could go on when '*' fits; then the operators are one item.
+  // Otherwise each expected token is listed, '=' included.
   bool operators = false;
+  bool expression_continues = has(P::STAR);
   for (auto t : expected.toList()) {
-    if (IsBinaryOperator(static_cast<std::size_t>(t))) {
+    if (expression_continues && IsBinaryOperator(static_cast<std::size_t>(t))) {
       operators = true;
     } else {
-      names.push_back(ExpectedName(static_cast<std::size_t>(t)));
+      names.push_back(ExpectedItem(static_cast<std::size_t>(t)));
     }
   }
   if (operators && (names.empty() || expects_end)) names.insert(names.begin(), "an operator");
@@ -814,36 +882,102 @@ void Session::ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext
 
 // ------------------------------------------------------------------ step 3: the IR
 
-// The one visitor: parse tree -> IR. Every visit returns an antlrcpp::Any
-// holding the IR piece (ExprPtr, StmtPtr, optional<PointExpr>, ...), or an
-// empty piece when the tree is incomplete after an error.
+// The one visitor: parse tree -> IR. Each visit leaves the IR piece it
+// built (an empty one when the tree is incomplete after an error) in a
+// member slot and returns an empty antlrcpp::Any: boxing every piece in an
+// Any would cost a heap allocation and a dynamic_cast per node.
 class IrBuilder : public grammar::PlaceBaseVisitor {
  public:
   explicit IrBuilder(Session& session) : s_(session) {}
 
-  ir::Program Build(P::ProgramContext* ctx) {
-    ir::Program program;
-    program.file = s_.file();
-    std::vector<P::TopLevelContext*> top = ctx->topLevel();
-    std::vector<antlr4::ParserRuleContext*> items(top.begin(), top.end());
-    program.items = BuildBlock(items, 1, s_.last_line() + 1);
-    return program;
-  }
+  // A block's statements plus its comment lines and blank-line marks, built
+  // line by line: Add() each statement in order, then Finish() at the line
+  // that closes the block (past the end of the file for the top level).
+  class BlockWalker {
+   public:
+    BlockWalker(IrBuilder& builder, std::uint32_t first) : b_(builder), line_(first) {}
+    void Add(antlr4::ParserRuleContext* item) {
+      std::uint32_t start = StartLine(item);
+      if (start < line_) return;  // a second statement on one line: an error
+      Until(start);
+      if (!b_.s_.LineHasError(start)) {
+        if (ir::StmtPtr stmt = b_.Stmt(item)) {
+          stmt->blank_line_before = blank_;
+          stmt->trailing_comment = b_.CommentOn(start);
+          block_.push_back(std::move(stmt));
+        }
+      }
+      blank_ = false;
+      line_ = std::max(start + 1, StopLine(item) + 1);
+    }
+    ir::Block Finish(std::uint32_t end) {
+      Until(end);
+      return std::move(block_);
+    }
+
+   private:
+    // The comment lines and blank lines before `end`.
+    void Until(std::uint32_t end) {
+      for (; line_ < end; ++line_) {
+        const Line* info = b_.s_.LineAt(line_);
+        if (info != nullptr && !info->had_code && info->comment != nullptr) {
+          auto stmt = std::make_unique<ir::Stmt>();
+          stmt->loc = b_.s_.Loc(info->comment);
+          stmt->length = b_.s_.Length(info->comment);
+          stmt->blank_line_before = blank_;
+          stmt->node = ir::Comment{b_.CommentOn(line_)};
+          block_.push_back(std::move(stmt));
+          blank_ = false;
+        } else {
+          blank_ = info != nullptr && !info->had_code && info->comment == nullptr;
+        }
+      }
+    }
+
+    IrBuilder& b_;
+    std::uint32_t line_;
+    bool blank_ = false;
+    ir::Block block_;
+  };
 
  private:
   // ---- helpers
-  template <typename T>
-  static T Take(antlrcpp::Any any) {
-    if (any.is<T>()) return std::move(any.as<T>());
-    return T{};
+  antlrcpp::Any Yield(ir::ExprPtr expr) {
+    expr_ = std::move(expr);
+    return {};
   }
-  ir::ExprPtr Expr(P::ExprContext* ctx) { return ctx == nullptr ? nullptr : Take<ir::ExprPtr>(visit(ctx)); }
+  antlrcpp::Any Yield(ir::StmtPtr stmt) {
+    stmt_ = std::move(stmt);
+    return {};
+  }
+  antlrcpp::Any Yield(std::optional<ir::PointExpr> point) {
+    point_ = std::move(point);
+    return {};
+  }
+  // Visits ctx; its visit method leaves the result in a slot via Yield.
+  void Accept(antlr4::ParserRuleContext* ctx) {
+    antlrcpp::Any boxed = ctx->accept(this);
+    SMTCAL_CHECK(boxed.isNull(), "a visit returned its IR in the Any instead of through Yield");
+  }
+  ir::ExprPtr Expr(P::ExprContext* ctx) {
+    if (ctx == nullptr) return nullptr;
+    expr_.reset();
+    Accept(ctx);
+    return std::move(expr_);
+  }
   std::optional<ir::PointExpr> Point(P::PointExprContext* ctx) {
     if (ctx == nullptr) return std::nullopt;
-    return Take<std::optional<ir::PointExpr>>(visit(ctx));
+    point_.reset();
+    Accept(ctx);
+    std::optional<ir::PointExpr> point = std::move(point_);
+    point_.reset();
+    return point;
   }
   ir::StmtPtr Stmt(antlr4::ParserRuleContext* ctx) {
-    return ctx == nullptr ? nullptr : Take<ir::StmtPtr>(visit(ctx));
+    if (ctx == nullptr) return nullptr;
+    stmt_.reset();
+    Accept(ctx);
+    return std::move(stmt_);
   }
   static std::uint32_t StartLine(antlr4::ParserRuleContext* ctx) {
     return static_cast<std::uint32_t>(ctx->getStart()->getLine());
@@ -896,49 +1030,13 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     return node == nullptr ? fallback : static_cast<std::uint32_t>(node->getSymbol()->getLine());
   }
 
-  // A block's statements plus its comment lines and blank-line marks, for
-  // the lines first .. end-1 (end is the line of the block's closer).
-  ir::Block BuildBlock(const std::vector<antlr4::ParserRuleContext*>& items, std::uint32_t first,
-                       std::uint32_t end) {
-    ir::Block block;
-    bool blank = false;
-    std::size_t next = 0;
-    for (std::uint32_t line = first; line < end;) {
-      while (next < items.size() && StartLine(items[next]) < line) ++next;
-      if (next < items.size() && StartLine(items[next]) == line) {
-        antlr4::ParserRuleContext* item = items[next++];
-        if (!s_.LineHasError(line)) {
-          if (ir::StmtPtr stmt = Stmt(item)) {
-            stmt->blank_line_before = blank;
-            stmt->trailing_comment = CommentOn(line);
-            block.push_back(std::move(stmt));
-          }
-        }
-        blank = false;
-        line = std::max(line + 1, StopLine(item) + 1);
-        continue;
-      }
-      const Line* info = s_.LineAt(line);
-      if (info != nullptr && !info->had_code && info->comment != nullptr) {
-        auto stmt = std::make_unique<ir::Stmt>();
-        stmt->loc = s_.Loc(info->comment);
-        stmt->length = s_.Length(info->comment);
-        stmt->blank_line_before = blank;
-        stmt->node = ir::Comment{CommentOn(line)};
-        block.push_back(std::move(stmt));
-        blank = false;
-      } else {
-        blank = info != nullptr && !info->had_code && info->comment == nullptr;
-      }
-      ++line;
-    }
-    return block;
-  }
   ir::Block Body(P::BlockContext* ctx, std::uint32_t first, std::uint32_t end) {
     if (ctx == nullptr) return {};
-    std::vector<P::StatementContext*> statements = ctx->statement();
-    std::vector<antlr4::ParserRuleContext*> items(statements.begin(), statements.end());
-    return BuildBlock(items, first, end);
+    BlockWalker walker(*this, first);
+    for (P::BlockLineContext* line : ctx->blockLine()) {
+      if (P::StatementContext* statement = line->statement()) walker.Add(statement);
+    }
+    return walker.Finish(end);
   }
 
   // A NUMBER token: value and whether it was written as a whole number.
@@ -986,31 +1084,31 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
   // ---- top level
   // programDecl : PROGRAM ID ;
   antlrcpp::Any visitProgramDecl(P::ProgramDeclContext* ctx) override {
-    return MakeStmt(ctx, ir::ProgramDecl{Name(ctx->ID())});
+    return Yield(MakeStmt(ctx, ir::ProgramDecl{Name(ctx->ID())}));
   }
   // unitsDecl : UNITS ID ;
   antlrcpp::Any visitUnitsDecl(P::UnitsDeclContext* ctx) override {
-    return MakeStmt(ctx, ir::UnitsDecl{Name(ctx->ID())});
+    return Yield(MakeStmt(ctx, ir::UnitsDecl{Name(ctx->ID())}));
   }
   // fixtureDecl : FIXTURE ID ;
   antlrcpp::Any visitFixtureDecl(P::FixtureDeclContext* ctx) override {
-    return MakeStmt(ctx, ir::FixtureDecl{Name(ctx->ID())});
+    return Yield(MakeStmt(ctx, ir::FixtureDecl{Name(ctx->ID())}));
   }
   // localDecl : LOCAL ID '=' coords (IN ID)? ;
   antlrcpp::Any visitLocalDecl(P::LocalDeclContext* ctx) override {
     std::optional<ir::Coords> coords = Coords(ctx->coords());
-    if (!coords) return ir::StmtPtr();
+    if (!coords) return Yield(ir::StmtPtr());
     ir::LocalDecl decl;
     decl.name = Name(ctx->ID(0));
     decl.origin = *coords;
     decl.frame = Name(ctx->ID(1));
     decl.frame_loc = Loc(ctx->ID(1));
-    return MakeStmt(ctx, std::move(decl));
+    return Yield(MakeStmt(ctx, std::move(decl)));
   }
   // pointDecl : TAUGHT? POINT ID '=' coords ((IN | ON) ID)? ;
   antlrcpp::Any visitPointDecl(P::PointDeclContext* ctx) override {
     std::optional<ir::Coords> coords = Coords(ctx->coords());
-    if (!coords) return ir::StmtPtr();
+    if (!coords) return Yield(ir::StmtPtr());
     ir::PointDecl decl;
     decl.name = Name(ctx->ID(0));
     decl.taught = ctx->TAUGHT() != nullptr;
@@ -1024,11 +1122,11 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     if (!decl.taught && ctx->ON() != nullptr) {
       s_.Error(DiagKind::ProgrammedPointOn, s_.Range(ctx->ON()->getSymbol()), decl.frame, decl.frame);
     }
-    return MakeStmt(ctx, std::move(decl));
+    return Yield(MakeStmt(ctx, std::move(decl)));
   }
   // palletDecl : PALLET NUMBER ',' ID ',' ID ',' ID ',' NUMBER ',' NUMBER ;
   antlrcpp::Any visitPalletDecl(P::PalletDeclContext* ctx) override {
-    if (ctx->NUMBER().size() != 3 || ctx->ID().size() != 3) return ir::StmtPtr();
+    if (ctx->NUMBER().size() != 3 || ctx->ID().size() != 3) return Yield(ir::StmtPtr());
     ir::PalletDecl decl;
     decl.number = WholeNumber(ctx->NUMBER(0), "the pallet number");
     for (std::size_t i = 0; i < 3; ++i) {
@@ -1037,11 +1135,11 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     }
     decl.columns = WholeNumber(ctx->NUMBER(1), "the number of pallet columns");
     decl.rows = WholeNumber(ctx->NUMBER(2), "the number of pallet rows");
-    return MakeStmt(ctx, std::move(decl));
+    return Yield(MakeStmt(ctx, std::move(decl)));
   }
   // vacuumDecl : VACUUM NUMBER ;
   antlrcpp::Any visitVacuumDecl(P::VacuumDeclContext* ctx) override {
-    return MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->NUMBER(), "the vacuum output")});
+    return Yield(MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->NUMBER(), "the vacuum output")}));
   }
   // varDecl : (INTEGER | REAL) ID (',' ID)* ;
   antlrcpp::Any visitVarDecl(P::VarDeclContext* ctx) override {
@@ -1051,51 +1149,53 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
       decl.names.push_back(Name(id));
       decl.name_locs.push_back(Loc(id));
     }
-    return MakeStmt(ctx, std::move(decl));
+    return Yield(MakeStmt(ctx, std::move(decl)));
   }
-  // functionDecl : functionHead NEWLINE block FEND ;
-  // functionHead : FUNCTION ID ('(' ')')? ;
+  // functionDecl : functionHead block FEND ;
+  // functionHead : FUNCTION ID ('(' ')')? NEWLINE ;
   antlrcpp::Any visitFunctionDecl(P::FunctionDeclContext* ctx) override {
-    if (ctx->functionHead() == nullptr) return ir::StmtPtr();
+    if (ctx->functionHead() == nullptr) return Yield(ir::StmtPtr());
     ir::Function function;
     function.name = Name(ctx->functionHead()->ID());
     std::uint32_t head = StartLine(ctx);
     function.body = Body(ctx->block(), head + 1, LineOf(ctx->FEND(), StopLine(ctx) + 1));
     function.end = End(ctx->FEND());
-    return MakeStmt(ctx, std::move(function));
+    return Yield(MakeStmt(ctx, std::move(function)));
   }
   // topLevel : programDecl | unitsDecl | ... ;
   antlrcpp::Any visitTopLevel(P::TopLevelContext* ctx) override {
-    return ctx->children.empty() ? antlrcpp::Any(ir::StmtPtr()) : visit(ctx->children.front());
+    if (!ctx->children.empty()) ctx->children.front()->accept(this);
+    return {};
   }
 
   // ---- statements
   // statement : varDecl | assignment | motion | ... ;
   antlrcpp::Any visitStatement(P::StatementContext* ctx) override {
-    return ctx->children.empty() ? antlrcpp::Any(ir::StmtPtr()) : visit(ctx->children.front());
+    if (!ctx->children.empty()) ctx->children.front()->accept(this);
+    return {};
   }
   // assignment : ID '=' expr ;
   antlrcpp::Any visitAssignment(P::AssignmentContext* ctx) override {
     ir::ExprPtr value = Expr(ctx->expr());
-    if (!value) return ir::StmtPtr();
-    return MakeStmt(ctx, ir::Assign{Name(ctx->ID()), std::move(value)});
+    if (!value) return Yield(ir::StmtPtr());
+    return Yield(MakeStmt(ctx, ir::Assign{Name(ctx->ID()), std::move(value)}));
   }
   // motion : (JUMP | GO | MOVE) pointExpr (LIMZ expr)? ;
   antlrcpp::Any visitMotion(P::MotionContext* ctx) override {
     std::optional<ir::PointExpr> target = Point(ctx->pointExpr());
-    if (!target) return ir::StmtPtr();
+    if (!target) return Yield(ir::StmtPtr());
     ir::Motion motion;
     motion.kind = ctx->GO() != nullptr     ? ir::MotionKind::Go
                   : ctx->MOVE() != nullptr ? ir::MotionKind::Move
                                            : ir::MotionKind::Jump;
     motion.target = std::move(*target);
     motion.limz = Expr(ctx->expr());
-    return MakeStmt(ctx, std::move(motion));
+    return Yield(MakeStmt(ctx, std::move(motion)));
   }
   // pickPlace : (PICK | PLACE) pointExpr (VACUUM expr)? (LIMZ expr)? ;
   antlrcpp::Any visitPickPlace(P::PickPlaceContext* ctx) override {
     std::optional<ir::PointExpr> target = Point(ctx->pointExpr());
-    if (!target) return ir::StmtPtr();
+    if (!target) return Yield(ir::StmtPtr());
     ir::PickPlace pick;
     pick.kind = ctx->PLACE() != nullptr ? ir::PickPlaceKind::Place : ir::PickPlaceKind::Pick;
     pick.target = std::move(*target);
@@ -1108,49 +1208,49 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
         (keyword == P::VACUUM ? pick.vacuum : pick.limz) = Expr(expr);
       }
     }
-    return MakeStmt(ctx, std::move(pick));
+    return Yield(MakeStmt(ctx, std::move(pick)));
   }
   // onOff : (ON | OFF) expr ;
   antlrcpp::Any visitOnOff(P::OnOffContext* ctx) override {
     ir::ExprPtr bit = Expr(ctx->expr());
-    if (!bit) return ir::StmtPtr();
-    return MakeStmt(ctx, ir::SetOutput{ctx->ON() != nullptr, std::move(bit)});
+    if (!bit) return Yield(ir::StmtPtr());
+    return Yield(MakeStmt(ctx, ir::SetOutput{ctx->ON() != nullptr, std::move(bit)}));
   }
   // waitStmt : WAIT expr ;   Sw(n) = On|Off waits for an input, else seconds.
   antlrcpp::Any visitWaitStmt(P::WaitStmtContext* ctx) override {
     ir::ExprPtr expr = Expr(ctx->expr());
-    if (!expr) return ir::StmtPtr();
+    if (!expr) return Yield(ir::StmtPtr());
     if (auto* eq = std::get_if<ir::BinaryExpr>(&expr->node); eq != nullptr && eq->op == ir::BinaryOp::Eq) {
       auto* sw = std::get_if<ir::SwitchRead>(&eq->lhs->node);
       auto* state = std::get_if<ir::OnOffLit>(&eq->rhs->node);
       if (sw != nullptr && state != nullptr) {
-        return MakeStmt(ctx, ir::WaitSwitch{std::move(sw->bit), state->on});
+        return Yield(MakeStmt(ctx, ir::WaitSwitch{std::move(sw->bit), state->on}));
       }
     }
-    return MakeStmt(ctx, ir::WaitTime{std::move(expr)});
+    return Yield(MakeStmt(ctx, ir::WaitTime{std::move(expr)}));
   }
-  // forStmt : forHead NEWLINE block NEXT ID? ;
-  // forHead : FOR ID '=' expr TO expr (STEP expr)? ;
+  // forStmt : forHead block NEXT ID? ;
+  // forHead : FOR ID '=' expr TO expr (STEP expr)? NEWLINE ;
   antlrcpp::Any visitForStmt(P::ForStmtContext* ctx) override {
     P::ForHeadContext* head = ctx->forHead();
-    if (head == nullptr || head->expr().size() < 2) return ir::StmtPtr();
+    if (head == nullptr || head->expr().size() < 2) return Yield(ir::StmtPtr());
     ir::For loop;
     loop.var = Name(head->ID());
     loop.var_loc = Loc(head->ID());
     loop.from = Expr(head->expr(0));
     loop.to = Expr(head->expr(1));
     loop.step = Expr(head->expr(2));
-    if (!loop.from || !loop.to) return ir::StmtPtr();
+    if (!loop.from || !loop.to) return Yield(ir::StmtPtr());
     loop.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->NEXT(), StopLine(ctx) + 1));
     loop.end = End(ctx->NEXT());
     loop.next_var = Name(ctx->ID());
-    return MakeStmt(ctx, std::move(loop));
+    return Yield(MakeStmt(ctx, std::move(loop)));
   }
-  // ifStmt     : ifHead NEWLINE block elseIfPart* elsePart? ENDIF ;
-  // elseIfPart : elseIfHead NEWLINE block ;     elsePart : ELSE NEWLINE block ;
+  // ifStmt     : ifHead block elseIfPart* elsePart? ENDIF ;
+  // elseIfPart : elseIfHead block ;       elsePart : elseHead block ;
   antlrcpp::Any visitIfStmt(P::IfStmtContext* ctx) override {
     P::IfHeadContext* head = ctx->ifHead();
-    if (head == nullptr) return ir::StmtPtr();
+    if (head == nullptr) return Yield(ir::StmtPtr());
     // The line where each branch starts, then the EndIf line.
     std::vector<std::uint32_t> starts = {StartLine(ctx)};
     for (auto* part : ctx->elseIfPart()) starts.push_back(StartLine(part));
@@ -1161,17 +1261,17 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     ir::IfBranch first;
     first.loc = Loc(head->IF());
     first.condition = Expr(head->expr());
-    if (!first.condition) return ir::StmtPtr();
+    if (!first.condition) return Yield(ir::StmtPtr());
     first.body = Body(ctx->block(), starts[0] + 1, starts[1]);
     stmt.branches.push_back(std::move(first));
     std::size_t k = 1;
     for (auto* part : ctx->elseIfPart()) {
       ir::IfBranch branch;
       P::ElseIfHeadContext* part_head = part->elseIfHead();
-      if (part_head == nullptr || s_.LineHasError(starts[k])) return ir::StmtPtr();
+      if (part_head == nullptr || s_.LineHasError(starts[k])) return Yield(ir::StmtPtr());
       branch.loc = Loc(part_head->ELSEIF());
       branch.condition = Expr(part_head->expr());
-      if (!branch.condition) return ir::StmtPtr();
+      if (!branch.condition) return Yield(ir::StmtPtr());
       branch.body = Body(part->block(), starts[k] + 1, starts[k + 1]);
       branch.comment = CommentOn(starts[k]);
       stmt.branches.push_back(std::move(branch));
@@ -1179,40 +1279,43 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     }
     if (P::ElsePartContext* part = ctx->elsePart()) {
       ir::IfBranch branch;
-      branch.loc = Loc(part->ELSE());
+      if (part->elseHead() == nullptr) return Yield(ir::StmtPtr());
+      branch.loc = Loc(part->elseHead()->ELSE());
       branch.body = Body(part->block(), starts[k] + 1, starts[k + 1]);
       branch.comment = CommentOn(starts[k]);
       stmt.branches.push_back(std::move(branch));
     }
     stmt.end = End(ctx->ENDIF());
-    return MakeStmt(ctx, std::move(stmt));
+    return Yield(MakeStmt(ctx, std::move(stmt)));
   }
   // callStmt : CALL ID ('(' ')')? ;
   antlrcpp::Any visitCallStmt(P::CallStmtContext* ctx) override {
-    return MakeStmt(ctx, ir::Call{Name(ctx->ID())});
+    return Yield(MakeStmt(ctx, ir::Call{Name(ctx->ID())}));
   }
-  // cycleStmt : cycleHead NEWLINE block ENDCYCLE ;    cycleHead : CYCLE ID ;
+  // cycleStmt : cycleHead block ENDCYCLE ;    cycleHead : CYCLE ID NEWLINE ;
   antlrcpp::Any visitCycleStmt(P::CycleStmtContext* ctx) override {
-    if (ctx->cycleHead() == nullptr) return ir::StmtPtr();
+    if (ctx->cycleHead() == nullptr) return Yield(ir::StmtPtr());
     ir::Cycle cycle;
     cycle.fixture = Name(ctx->cycleHead()->ID());
     cycle.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->ENDCYCLE(), StopLine(ctx) + 1));
     cycle.end = End(ctx->ENDCYCLE());
-    return MakeStmt(ctx, std::move(cycle));
+    return Yield(MakeStmt(ctx, std::move(cycle)));
   }
   // scanStmt : SCAN ID ;
   antlrcpp::Any visitScanStmt(P::ScanStmtContext* ctx) override {
-    return MakeStmt(ctx, ir::Scan{Name(ctx->ID())});
+    return Yield(MakeStmt(ctx, ir::Scan{Name(ctx->ID())}));
   }
   // exitStmt : EXIT FUNCTION ;
-  antlrcpp::Any visitExitStmt(P::ExitStmtContext* ctx) override { return MakeStmt(ctx, ir::ExitFunction{}); }
+  antlrcpp::Any visitExitStmt(P::ExitStmtContext* ctx) override {
+    return Yield(MakeStmt(ctx, ir::ExitFunction{}));
+  }
 
   // ---- points
   // pointExpr : pointAtom (('+' | '-') offset)* ;
   // offset    : ID '(' expr ')' ;
   antlrcpp::Any visitPointExpr(P::PointExprContext* ctx) override {
     std::optional<ir::PointExpr> point;
-    if (ctx->pointAtom() == nullptr) return point;
+    if (ctx->pointAtom() == nullptr) return Yield(std::move(point));
     point.emplace();
     point->loc = s_.Loc(ctx->getStart());
     P::PointAtomContext* atom = ctx->pointAtom();
@@ -1220,17 +1323,17 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
       point->base = ir::NamedPoint{Name(named->ID()), s_.Length(named->getStart())};
     } else if (auto* literal = dynamic_cast<P::LiteralPointContext*>(atom)) {
       std::optional<ir::Coords> coords = Coords(literal->coords());
-      if (!coords) return std::optional<ir::PointExpr>();
+      if (!coords) return Yield(std::optional<ir::PointExpr>());
       point->base = *coords;
     } else if (auto* pallet = dynamic_cast<P::PalletPointContext*>(atom)) {
       ir::PalletPoint base;
       base.number = Expr(pallet->expr(0));
       base.i = Expr(pallet->expr(1));
       base.j = Expr(pallet->expr(2));
-      if (!base.number || !base.i) return std::optional<ir::PointExpr>();
+      if (!base.number || !base.i) return Yield(std::optional<ir::PointExpr>());
       point->base = std::move(base);
     } else {
-      return std::optional<ir::PointExpr>();
+      return Yield(std::optional<ir::PointExpr>());
     }
     // Each offset follows its sign token.
     bool negative = false;
@@ -1240,7 +1343,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
         sign = terminal->getSymbol();
         negative = sign->getType() == P::MINUS;
       } else if (auto* offset = dynamic_cast<P::OffsetContext*>(child)) {
-        if (offset->ID() == nullptr || sign == nullptr) return std::optional<ir::PointExpr>();
+        if (offset->ID() == nullptr || sign == nullptr) return Yield(std::optional<ir::PointExpr>());
         ir::PointOffset out;
         out.loc = s_.Loc(sign);
         out.negative = negative;
@@ -1257,34 +1360,34 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
           s_.Error(DiagKind::UnknownOffsetAxis, s_.Range(offset->ID()->getSymbol()), axis);
         }
         out.amount = Expr(offset->expr());
-        if (!out.amount) return std::optional<ir::PointExpr>();
+        if (!out.amount) return Yield(std::optional<ir::PointExpr>());
         point->offsets.push_back(std::move(out));
       }
     }
-    return point;
+    return Yield(std::move(point));
   }
 
   // ---- expressions
   // expr : '(' expr ')'
-  antlrcpp::Any visitParenExpr(P::ParenExprContext* ctx) override { return Expr(ctx->expr()); }
+  antlrcpp::Any visitParenExpr(P::ParenExprContext* ctx) override { return Yield(Expr(ctx->expr())); }
   //      | op=('-' | '+' | NOT) expr
   antlrcpp::Any visitUnaryExpr(P::UnaryExprContext* ctx) override {
     ir::ExprPtr operand = Expr(ctx->expr());
-    if (!operand || ctx->op == nullptr) return ir::ExprPtr();
+    if (!operand || ctx->op == nullptr) return Yield(ir::ExprPtr());
     ir::ExprPtr expr = NewExpr(ctx);
     std::size_t op = ctx->op->getType();
     expr->node = ir::UnaryExpr{op == P::MINUS ? ir::UnaryOp::Negate
                                : op == P::PLUS ? ir::UnaryOp::Plus
                                                : ir::UnaryOp::Not,
                                std::move(operand)};
-    return expr;
+    return Yield(std::move(expr));
   }
   //      | expr op=(...) expr
   antlrcpp::Any visitBinaryExpr(P::BinaryExprContext* ctx) override {
-    if (ctx->expr().size() != 2 || ctx->op == nullptr) return ir::ExprPtr();
+    if (ctx->expr().size() != 2 || ctx->op == nullptr) return Yield(ir::ExprPtr());
     ir::ExprPtr lhs = Expr(ctx->expr(0));
     ir::ExprPtr rhs = Expr(ctx->expr(1));
-    if (!lhs || !rhs) return ir::ExprPtr();
+    if (!lhs || !rhs) return Yield(ir::ExprPtr());
     ir::BinaryOp op;
     switch (ctx->op->getType()) {
       case P::PLUS: op = ir::BinaryOp::Add; break;
@@ -1301,40 +1404,43 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
       case P::AND: op = ir::BinaryOp::And; break;
       case P::OR: op = ir::BinaryOp::Or; break;
       case P::XOR: op = ir::BinaryOp::Xor; break;
-      default: return ir::ExprPtr();
+      default: return Yield(ir::ExprPtr());
     }
     ir::ExprPtr expr = NewExpr(ctx);
     expr->node = ir::BinaryExpr{op, std::move(lhs), std::move(rhs)};
-    return expr;
+    return Yield(std::move(expr));
   }
   //      | SW '(' expr ')'
   antlrcpp::Any visitSwitchExpr(P::SwitchExprContext* ctx) override {
     ir::ExprPtr bit = Expr(ctx->expr());
-    if (!bit) return ir::ExprPtr();
+    if (!bit) return Yield(ir::ExprPtr());
     ir::ExprPtr expr = NewExpr(ctx);
     expr->node = ir::SwitchRead{std::move(bit)};
-    return expr;
+    return Yield(std::move(expr));
   }
   //      | (ON | OFF)
   antlrcpp::Any visitOnOffExpr(P::OnOffExprContext* ctx) override {
     ir::ExprPtr expr = NewExpr(ctx);
     expr->node = ir::OnOffLit{ctx->ON() != nullptr};
-    return expr;
+    return Yield(std::move(expr));
   }
   //      | NUMBER
   antlrcpp::Any visitNumberExpr(P::NumberExprContext* ctx) override {
     ir::ExprPtr expr = NewExpr(ctx);
     expr->node = Number(ctx->NUMBER());
-    return expr;
+    return Yield(std::move(expr));
   }
   //      | ID
   antlrcpp::Any visitVariableExpr(P::VariableExprContext* ctx) override {
     ir::ExprPtr expr = NewExpr(ctx);
     expr->node = ir::VariableRef{Name(ctx->ID())};
-    return expr;
+    return Yield(std::move(expr));
   }
 
   Session& s_;
+  ir::ExprPtr expr_;
+  ir::StmtPtr stmt_;
+  std::optional<ir::PointExpr> point_;
 };
 
 // ------------------------------------------------------------------ driver
@@ -1343,17 +1449,26 @@ ir::Program Session::Run() {
   ir::Program program;
   program.file = file_;
   try {
-    Lex();
+    SyntaxErrorListener listener(*this);
+    Lex(listener);
     PreScan();
     antlr4::ListTokenSource source(ParserTokens());
     antlr4::CommonTokenStream tokens(&source);
     PlaceParser parser(&tokens);
-    SyntaxErrorListener listener(*this);
     parser.removeErrorListeners();
     parser.addErrorListener(&listener);
     parser.setErrorHandler(std::make_shared<LineErrorStrategy>(*this));
-    P::ProgramContext* tree = parser.program();
-    program = IrBuilder(*this).Build(tree);
+    // One top-level line (a declaration, or a whole Function) at a time,
+    // freeing its parse tree once it is IR: the tree of a large program
+    // would take several times the memory of its IR.
+    IrBuilder builder(*this);
+    IrBuilder::BlockWalker top(builder, 1);
+    while (tokens.LA(1) != Token::EOF) {
+      P::ProgramLineContext* line = parser.programLine();
+      if (P::TopLevelContext* item = line->topLevel()) top.Add(item);
+      parser.getTreeTracker().reset();
+    }
+    program.items = top.Finish(last_line() + 1);
   } catch (const std::exception& e) {
     // ANTLR gave up in a way its recovery does not cover; say so plainly.
     Error(DiagKind::SyntaxError, SourceLoc{file_, 0, 0},

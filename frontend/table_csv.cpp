@@ -25,6 +25,41 @@ std::string Lowercase(std::string_view text) {
   return lower;
 }
 
+// The length of the valid UTF-8 sequence at text[i], or 0 if there is none.
+std::size_t Utf8Length(std::string_view text, std::size_t i) {
+  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char lead = byte(i);
+  std::size_t length = lead < 0x80           ? 1
+                       : (lead >> 5) == 0x6   ? 2
+                       : (lead >> 4) == 0xe   ? 3
+                       : (lead >> 3) == 0x1e  ? 4
+                                              : 0;
+  if (length == 0 || i + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(i + k) & 0xc0) != 0x80) return 0;
+  }
+  return length;
+}
+
+// A field's text for a message: control characters and bytes that are not
+// UTF-8 shown as \xNN, so a binary file cannot garble the terminal, cut a
+// message short, or make the JSON output invalid.
+std::string Printable(std::string_view text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    auto byte = static_cast<unsigned char>(text[i]);
+    std::size_t length = Utf8Length(text, i);
+    if (length == 0 || byte < 0x20 || byte == 0x7f) {
+      out += fmt::format("\\x{:02x}", byte);
+      ++i;
+    } else {
+      out += text.substr(i, length);
+      i += length;
+    }
+  }
+  return out;
+}
+
 SourceLoc At(std::uint32_t file, std::uint32_t line, std::size_t offset) {
   return SourceLoc{file, line, static_cast<std::uint32_t>(offset + 1)};
 }
@@ -108,10 +143,10 @@ const Schema kRawSchema{
     "a raw measurement file", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
 const Schema kPointSchema{"a point list", {"x_mm", "y_mm"}, 2, true};
 
-std::string JoinColumns(const Schema& schema, std::size_t count) {
+std::string JoinColumns(const Schema& schema, std::size_t count, std::string_view separator = ", ") {
   std::string text;
   for (std::size_t i = 0; i < count; ++i) {
-    if (i > 0) text += ", ";
+    if (i > 0) text += separator;
     text += schema.columns[i];
   }
   return text;
@@ -157,13 +192,15 @@ std::optional<Header> ReadHeader(const CsvRecord& record, const Schema& schema, 
   header.field_count = record.fields.size();
   bool ok = true;
   std::vector<std::string> known(schema.columns.begin(), schema.columns.end());
+  std::vector<std::string> suggested;  // a misspelt column is not reported missing as well
   for (std::size_t f = 0; f < record.fields.size(); ++f) {
     const CsvField& field = record.fields[f];
     std::string name = Lowercase(field.text);
     auto it = std::find(schema.columns.begin(), schema.columns.end(), name);
     if (it == schema.columns.end()) {
       std::string closest = ClosestName(field.text, known);
-      diags.Report(DiagKind::CsvUnknownColumn, field.range, field.text,
+      suggested.push_back(closest);
+      diags.Report(DiagKind::CsvUnknownColumn, field.range, Printable(field.text),
                    closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), schema.what,
                    JoinColumns(schema, schema.columns.size()));
       ok = false;
@@ -179,11 +216,21 @@ std::optional<Header> ReadHeader(const CsvRecord& record, const Schema& schema, 
     }
     header.field_of[column] = f;
   }
+  std::vector<std::string> missing;
   for (std::size_t c = 0; c < schema.required; ++c) {
     if (header.field_of[c]) continue;
-    diags.Report(DiagKind::CsvMissingColumn, SourceRange(SourceLoc{record.end.file, record.line, 1}),
-                 schema.columns[c], schema.what, JoinColumns(schema, schema.required));
     ok = false;
+    std::string column(schema.columns[c]);
+    if (std::find(suggested.begin(), suggested.end(), column) == suggested.end()) missing.push_back(column);
+  }
+  if (!missing.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < missing.size(); ++i) {
+      list += fmt::format("{}'{}'", i == 0 ? "" : i + 1 == missing.size() ? " and " : ", ", missing[i]);
+    }
+    diags.Report(DiagKind::CsvMissingColumn, SourceRange(SourceLoc{record.end.file, record.line, 1}),
+                 fmt::format("{} {}", missing.size() == 1 ? "column" : "columns", list), schema.what,
+                 JoinColumns(schema, schema.required));
   }
   if (!ok) return std::nullopt;
   return header;
@@ -238,7 +285,7 @@ class Row {
     std::string name = Lowercase(field->text);
     if (name == "x") return TableAxis::X;
     if (name == "y") return TableAxis::Y;
-    diags_.Report(DiagKind::TableBadAxis, field->range, field->text);
+    diags_.Report(DiagKind::TableBadAxis, field->range, Printable(field->text));
     ok = false;
     return std::nullopt;
   }
@@ -250,13 +297,13 @@ class Row {
     if (!Present(column, field)) return std::nullopt;
     std::optional<double> value = ParseDouble(field->text);
     if (!value) {
-      diags_.Report(DiagKind::CsvBadNumber, field->range, field->text, schema_.columns[column],
+      diags_.Report(DiagKind::CsvBadNumber, field->range, Printable(field->text), schema_.columns[column],
                     NumberHint(field->text));
       ok = false;
       return std::nullopt;
     }
     if (!std::isfinite(*value)) {
-      diags_.Report(DiagKind::CsvNonFinite, field->range, field->text, schema_.columns[column]);
+      diags_.Report(DiagKind::CsvNonFinite, field->range, Printable(field->text), schema_.columns[column]);
       ok = false;
       return std::nullopt;
     }
@@ -273,7 +320,7 @@ class Row {
     long long value = 0;
     auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (text.empty() || ec != std::errc() || end != text.data() + text.size() || value < minimum) {
-      diags_.Report(DiagKind::CsvBadCount, field->range, field->text, schema_.columns[column], minimum);
+      diags_.Report(DiagKind::CsvBadCount, field->range, Printable(field->text), schema_.columns[column], minimum);
       ok = false;
       return std::nullopt;
     }
@@ -314,11 +361,12 @@ struct Body {
 };
 
 std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnostics& diags) {
+  const std::size_t errors_before = diags.error_count();
   std::vector<CsvRecord> records = SplitCsv(file, diags);
   const std::string& name = diags.sources().File(file).name;
   if (records.empty()) {
-    if (!diags.has_errors()) {
-      diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), name);
+    if (diags.error_count() == errors_before) {  // else the lines were all malformed
+      diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name));
     }
     return std::nullopt;
   }
@@ -332,11 +380,11 @@ std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnosti
     body.header = DefaultHeader(schema);
   } else {
     diags.Report(DiagKind::CsvMissingHeader, records.front().fields.front().range,
-                 JoinColumns(schema, schema.required));
+                 JoinColumns(schema, schema.required, ","));
     return std::nullopt;
   }
   if (records.empty()) {
-    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), name);
+    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name));
     return std::nullopt;
   }
   body.records = std::move(records);

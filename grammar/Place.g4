@@ -5,10 +5,14 @@
 grammar Place;
 
 // ---------------------------------------------------------------- structure
-// Every line ends in NEWLINE: frontend/parse.cpp adds one after a last line
-// that lacks it. (Allowing "topLevel? EOF" here would make ANTLR look ahead
-// through a whole Function to choose between the two ways to end a line.)
-program     : (topLevel? NEWLINE)* EOF ;
+// A line is the unit of error recovery: each line is its own rule ending in
+// its NEWLINE, so a mistake anywhere in a line is caught inside that line and
+// never abandons the block around it. Every line ends in NEWLINE:
+// frontend/parse.cpp adds one after a last line that lacks it. (Allowing
+// "topLevel? EOF" would make ANTLR look ahead through a whole Function to
+// choose between the two ways to end a line.)
+program     : programLine* EOF ;
+programLine : topLevel? NEWLINE ;
 
 topLevel    : programDecl
             | unitsDecl
@@ -29,15 +33,15 @@ pointDecl   : TAUGHT? POINT ID '=' coords ((IN | ON) ID)? ;
 palletDecl  : PALLET NUMBER ',' ID ',' ID ',' ID ',' NUMBER ',' NUMBER ;
 vacuumDecl  : VACUUM NUMBER ;
 varDecl     : (INTEGER | REAL) ID (',' ID)* ;
-functionDecl: functionHead NEWLINE block FEND ;
-// The opening line of each block is its own rule, so that a mistake on that
-// line is recovered inside it and never abandons the whole block.
-functionHead: FUNCTION ID ('(' ')')? ;
+functionDecl: functionHead block FEND ;
+// The opening line of each block is its own rule, for the same reason.
+functionHead: FUNCTION ID ('(' ')')? NEWLINE ;
 
 coords      : XY '(' signedNumber ',' signedNumber ',' signedNumber ',' signedNumber ')' ;
 signedNumber: ('-' | '+')? NUMBER ;
 
-block       : (statement? NEWLINE)* ;
+block       : blockLine* ;
+blockLine   : statement? NEWLINE ;
 
 statement   : varDecl
             | assignment
@@ -60,16 +64,17 @@ onOff       : (ON | OFF) expr ;
 // Wait Sw(n) = On|Off waits for an input; any other Wait expr waits that
 // many seconds. Both are one rule (LL(1)); the visitor tells them apart.
 waitStmt    : WAIT expr ;
-forStmt     : forHead NEWLINE block NEXT ID? ;
-forHead     : FOR ID '=' expr TO expr (STEP expr)? ;
-ifStmt      : ifHead NEWLINE block elseIfPart* elsePart? ENDIF ;
-ifHead      : IF expr THEN ;
-elseIfPart  : elseIfHead NEWLINE block ;
-elseIfHead  : ELSEIF expr THEN ;
-elsePart    : ELSE NEWLINE block ;
+forStmt     : forHead block NEXT ID? ;
+forHead     : FOR ID '=' expr TO expr (STEP expr)? NEWLINE ;
+ifStmt      : ifHead block elseIfPart* elsePart? ENDIF ;
+ifHead      : IF expr THEN NEWLINE ;
+elseIfPart  : elseIfHead block ;
+elseIfHead  : ELSEIF expr THEN NEWLINE ;
+elsePart    : elseHead block ;
+elseHead    : ELSE NEWLINE ;
 callStmt    : CALL ID ('(' ')')? ;
-cycleStmt   : cycleHead NEWLINE block ENDCYCLE ;
-cycleHead   : CYCLE ID ;
+cycleStmt   : cycleHead block ENDCYCLE ;
+cycleHead   : CYCLE ID NEWLINE ;
 scanStmt    : SCAN ID ;
 exitStmt    : EXIT FUNCTION ;
 

@@ -156,7 +156,8 @@ std::optional<AxisTable> AxisAssembly::Run() {
       bool is_x = coord[0] == 'x';
       Diagnostic* diag = diags.Report(
           DiagKind::TableGridLinesTooClose, is_x ? later.x_field : later.y_field, coord,
-          FormatMm(lines[i - 1]), FormatMm(lines[i]), name, FormatMm(gap), FormatMm(kMinGridLineSpacingMm));
+          FormatMm(lines[i - 1]), FormatMm(lines[i]), name, fmt::format("{:.6f}", gap),
+          FormatMm(kMinGridLineSpacingMm));
       Diagnostics::AddNote(diag, is_x ? earlier.x_field : earlier.y_field,
                            fmt::format("a row on the {} line {}", coord, FormatMm(lines[i - 1])));
     }
@@ -165,7 +166,11 @@ std::optional<AxisTable> AxisAssembly::Run() {
   check_spacing(ys, y_lines, "y");
 
   if (!too_close && (nx < 2 || ny < 2)) {
-    diags.Report(DiagKind::TableGridTooSmall, nodes[members.front()].error_field, name, nx, ny);
+    auto lines = [](std::size_t n, const char* coord) {
+      return fmt::format("{} {} {}", n, coord, n == 1 ? "line" : "lines");
+    };
+    diags.Report(DiagKind::TableGridTooSmall, nodes[members.front()].error_field, name, lines(nx, "x"),
+                 lines(ny, "y"));
   }
 
   if (!too_close && nx >= 2 && ny >= 2) {
@@ -280,10 +285,16 @@ Rect TableDomain(const ErrorTable& table) {
 // ------------------------------------------------------------------ evaluation
 
 int CalibrationMap::Lines::Cell(double v) const {
+  // O(1) on (nearly) uniform grids: the mean pitch gives the cell or its
+  // neighbour. Otherwise a binary search: O(log n).
   double guess = (v - origin) * cells_per_mm;
   int i = guess <= 0 ? 0 : guess >= last_cell ? last_cell : static_cast<int>(guess);
-  while (i > 0 && v < lines[i]) --i;
-  while (i < last_cell && v >= lines[i + 1]) ++i;
+  if (i > 0 && v < lines[i]) --i;
+  if (i < last_cell && v >= lines[i + 1]) ++i;
+  if ((i > 0 && v < lines[i]) || (i < last_cell && v >= lines[i + 1])) {
+    auto above = std::upper_bound(lines.begin() + 1, lines.end() - 1, v);
+    i = static_cast<int>(above - lines.begin()) - 1;
+  }
   return i;
 }
 

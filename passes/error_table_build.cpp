@@ -6,6 +6,7 @@
 #include "passes/error_table_build.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -80,14 +81,27 @@ void WarnNoisyNodes(const std::vector<RawMeasurement>& measurements, const std::
   }
 }
 
+// The repetition scatter a set shift is measured against: the node's own, but
+// never less than the median of its axis. A node whose few repetitions happen
+// to agree closely must not make an ordinary set difference look significant.
 void WarnSetShifts(const std::vector<RawMeasurement>& measurements, const std::vector<NodeSummary>& nodes,
                    Diagnostics& diags) {
+  std::array<double, 2> median{0, 0};
+  for (TableAxis axis : kTableAxes) {
+    std::vector<double> spreads;
+    for (const NodeSummary& node : nodes) {
+      if (node.axis == axis && node.pooled_stddev_mm) spreads.push_back(*node.pooled_stddev_mm);
+    }
+    if (!spreads.empty()) median[static_cast<int>(axis)] = Median(spreads);
+  }
   for (const NodeSummary& node : nodes) {
-    if (!node.set_spread_stderr_mm) continue;
+    if (!node.set_spread_weight) continue;
+    const double scatter = std::max(*node.pooled_stddev_mm, median[static_cast<int>(node.axis)]);
+    const double stderr_mm = scatter * *node.set_spread_weight;
     const double spread = node.set_mean_spread_mm;
-    if (spread <= kSetShiftFloorMm || spread <= kSetShiftFactor * *node.set_spread_stderr_mm) continue;
+    if (spread <= kSetShiftFloorMm || spread <= kSetShiftFactor * stderr_mm) continue;
     diags.Report(DiagKind::RawSetShift, measurements[node.rows.front()].error_field, FormatMm(node.x_mm),
-                 FormatMm(node.y_mm), AxisName(node.axis), Um(spread), Um(*node.pooled_stddev_mm),
+                 FormatMm(node.y_mm), AxisName(node.axis), Um(spread), Um(scatter),
                  LineRanges(measurements, node.rows));
   }
 }
@@ -150,7 +164,7 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
     }
     if (low != nullptr && low != high && node.pooled_stddev_mm) {
       node.set_mean_spread_mm = high->first / high->second - low->first / low->second;
-      node.set_spread_stderr_mm = *node.pooled_stddev_mm * std::sqrt(1.0 / low->second + 1.0 / high->second);
+      node.set_spread_weight = std::sqrt(1.0 / low->second + 1.0 / high->second);
     }
     nodes.push_back(std::move(node));
   }

@@ -36,8 +36,10 @@ struct NodeSummary {
   double mean_mm = 0;
   std::optional<double> stddev_mm;         // sample stddev of all measurements (n >= 2)
   std::optional<double> pooled_stddev_mm;  // pooled within-set stddev (repetition scatter)
-  double set_mean_spread_mm = 0;           // largest minus smallest set mean
-  std::optional<double> set_spread_stderr_mm;  // its standard error from the pooled stddev
+  double set_mean_spread_mm = 0;           // largest minus smallest set mean (sets of 2 or more)
+  // sqrt(1/n_low + 1/n_high): the spread's standard error per unit of
+  // repetition scatter (given when there are two such sets and a pooled stddev).
+  std::optional<double> set_spread_weight;
 };
 
 // Groups measurements by node and summarizes each (sorted by axis, x, y).

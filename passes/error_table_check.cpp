@@ -74,9 +74,12 @@ SourceRange SuspectNode(const ErrorTable& table, const PieceBound& piece) {
   return best;
 }
 
-std::string MoreCells(std::size_t more, const char* what) {
-  if (more == 0) return "";
-  return fmt::format("{} more {} {} too", more, more == 1 ? "cell" : "cells", what);
+// "3 more cells fold or nearly fold", as a note at the file's name.
+void AddMoreCellsNote(Diagnostic* diag, const SourceRange& suspect, std::size_t more, const char* one,
+                      const char* many) {
+  if (more == 0) return;
+  Diagnostics::AddNote(diag, SourceRange(SourceLoc{suspect.begin.file, 0, 0}),
+                       fmt::format("{} more {} {}", more, more == 1 ? "cell" : "cells", more == 1 ? one : many));
 }
 
 void ReportFolds(const ErrorTable& table, const TableAnalysis& analysis, Diagnostics& diags) {
@@ -89,15 +92,14 @@ void ReportFolds(const ErrorTable& table, const TableAnalysis& analysis, Diagnos
   }
   if (worst == nullptr) return;
   const Eigen::Matrix2d& g = worst->slopes_at_min_det;
+  const SourceRange suspect = SuspectNode(table, *worst);
   Diagnostic* diag = diags.Report(
-      DiagKind::TableFolds, SuspectNode(table, *worst), worst->min_det <= 0 ? "folds" : "nearly folds",
+      DiagKind::TableFolds, suspect, worst->min_det <= 0 ? "folds" : "nearly folds",
       FormatMm(worst->piece.x0), FormatMm(worst->piece.x1), FormatMm(worst->piece.y0),
       FormatMm(worst->piece.y1), Fixed(worst->min_det, 3), FormatMm(worst->min_det_at.x()),
       FormatMm(worst->min_det_at.y()), Fixed(kMinJacobianDet, 1), Fixed(g(0, 0), 4), Fixed(g(0, 1), 4),
       Fixed(g(1, 0), 4), Fixed(g(1, 1), 4));
-  if (failing > 1) {
-    Diagnostics::AddNote(diag, SourceRange(), MoreCells(failing - 1, "fold or nearly fold"));
-  }
+  AddMoreCellsNote(diag, suspect, failing - 1, "folds or nearly folds", "fold or nearly fold");
 }
 
 void ReportSteep(const ErrorTable& table, const TableAnalysis& analysis, Diagnostics& diags) {
@@ -111,12 +113,13 @@ void ReportSteep(const ErrorTable& table, const TableAnalysis& analysis, Diagnos
   if (worst == nullptr) return;
   const Eigen::Matrix2d& g = worst->slopes_at_max;
   std::string_view axis = AxisName(static_cast<TableAxis>(worst->steepest_axis));
+  const SourceRange suspect = SuspectNode(table, *worst);
   Diagnostic* diag = diags.Report(
-      DiagKind::TableTooSteep, SuspectNode(table, *worst), axis, FormatMm(worst->piece.x0),
+      DiagKind::TableTooSteep, suspect, axis, FormatMm(worst->piece.x0),
       FormatMm(worst->piece.x1), FormatMm(worst->piece.y0), FormatMm(worst->piece.y1), axis, axis,
       Fixed(worst->max_row_slope, 4), Fixed(kMaxErrorSlope, 1), Fixed(g(0, 0), 4), Fixed(g(0, 1), 4),
       Fixed(g(1, 0), 4), Fixed(g(1, 1), 4));
-  if (failing > 1) Diagnostics::AddNote(diag, SourceRange(), MoreCells(failing - 1, "are too steep"));
+  AddMoreCellsNote(diag, suspect, failing - 1, "is too steep", "are too steep");
 }
 
 void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {

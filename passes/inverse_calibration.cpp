@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/LU>
-
 #include "frontend/check.h"
 
 namespace smtcal {
@@ -93,10 +91,14 @@ Solution InverseSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy polic
   Eigen::Matrix2d jacobian;
   map_.DeltaAndJacobian(n, delta, jacobian);
   Eigen::Vector2d residual = n + delta - actual;
+  double norm = residual.norm();
   int iterations = 0;
-  while (residual.norm() > kInverseResidualTolMm) {
-    if (iterations == iteration_bound_) break;
+  // The bound guarantees kInverseResidualTolMm; the iterations it allows
+  // beyond that polish the result to machine precision.
+  while (norm > kInversePolishMm && iterations < iteration_bound_) {
     ++iterations;
+    const Eigen::Vector2d previous_n = n, previous_delta = delta, previous_residual = residual;
+    const Eigen::Matrix2d previous_jacobian = jacobian;
     // Newton: solve (I + J) step = residual. In a valid table det >= 1/2
     // inside and >= 1 - L outside (a clamped coordinate has zero slope).
     const double a = 1 + jacobian(0, 0), b = jacobian(0, 1), c = jacobian(1, 0), d = 1 + jacobian(1, 1);
@@ -124,53 +126,76 @@ Solution InverseSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy polic
       map_.DeltaAndJacobian(n, delta, jacobian);
       residual = n + delta - actual;
     }
+    const double new_norm = residual.norm();
+    if (!(new_norm < norm)) {  // rounding, not the table, limits it now: keep the better point
+      n = previous_n, delta = previous_delta, residual = previous_residual, jacobian = previous_jacobian;
+      break;
+    }
+    norm = new_norm;
   }
-  Solution solution{n, residual.norm(), iterations, SolveStatus::kOk};
+  Solution solution{n, norm, iterations, SolveStatus::kOk};
   if (solution.residual_mm > kInverseResidualTolMm) solution.status = SolveStatus::kNotConverged;
   return ApplyPolicy(map_, solution, n, actual, policy);
 }
 
 // ------------------------------------------------------------------ the paper's solver
 
+namespace {
+
+// The edges [lo, hi] and the lines strictly between them.
+std::vector<double> LinesWithin(const std::vector<double>& lines, double lo, double hi) {
+  std::vector<double> within = {lo};
+  for (double v : lines) {
+    if (v > lo && v < hi) within.push_back(v);
+  }
+  within.push_back(hi);
+  return within;
+}
+
+// Inverts the piecewise-linear map nominal -> nominal + delta(nominal) given
+// at `nodes` (increasing; delta(k) is the error at nodes[k]) for `actual`,
+// by linear interpolation between neighbouring nodes. Beyond the ends the
+// edge error is used (slope 1), the direct calibration's own extension.
+template <typename Delta>
+double InvertPiecewiseLinear(const std::vector<double>& nodes, Delta delta, double actual) {
+  double previous = nodes[0] + delta(nodes[0]);
+  if (actual <= previous) return nodes[0] + (actual - previous);
+  for (std::size_t k = 1; k < nodes.size(); ++k) {
+    double here = nodes[k] + delta(nodes[k]);
+    if (actual <= here) return nodes[k - 1] + (actual - previous) / (here - previous) * (nodes[k] - nodes[k - 1]);
+    previous = here;
+  }
+  return nodes.back() + (actual - previous);
+}
+
+}  // namespace
+
 PaperSolver::PaperSolver(const ErrorTable& table, double tolerance_mm, int max_steps)
     : map_(table), tolerance_mm_(tolerance_mm), max_steps_(max_steps) {
   CheckSolvable(AnalyzeTable(table));
   SMTCAL_CHECK(tolerance_mm > 0 && max_steps >= 2, "the paper's solver needs a tolerance and 2 steps");
+  const Rect& d = map_.domain();
+  row_xs_ = LinesWithin(map_.xs(TableAxis::X), d.x0, d.x1);
+  row_ys_ = LinesWithin(map_.ys(TableAxis::X), d.y0, d.y1);
+  column_ys_ = LinesWithin(map_.ys(TableAxis::Y), d.y0, d.y1);
+  column_xs_ = LinesWithin(map_.xs(TableAxis::Y), d.x0, d.x1);
 }
 
 // The discrete function x_N(x_N + Delta-x, y_N) on the row at nominal y: the
 // row's nodes map nominal x_i to actual x_i + Delta-x(x_i, y) (between grid
 // rows Delta-x is interpolated linearly along each column), and the actual x
-// is inverted by linear interpolation between neighbouring nodes. Beyond the
-// row's ends the edge value of Delta-x is used (slope 1), the same extension
-// as the direct calibration's.
+// is inverted by linear interpolation between neighbouring nodes. Rows are
+// taken where F is defined (the domain; outside it, its edge row), so the
+// paper's functions and the direct calibration agree everywhere.
 double PaperSolver::NominalXOnRow(double actual_x, double y) const {
-  const std::vector<double>& xs = map_.xs(TableAxis::X);
-  double previous = xs[0] + map_.AxisDelta(TableAxis::X, xs[0], y);
-  if (actual_x <= previous) return xs[0] + (actual_x - previous);
-  for (std::size_t i = 1; i < xs.size(); ++i) {
-    double here = xs[i] + map_.AxisDelta(TableAxis::X, xs[i], y);
-    if (actual_x <= here) {
-      return xs[i - 1] + (actual_x - previous) / (here - previous) * (xs[i] - xs[i - 1]);
-    }
-    previous = here;
-  }
-  return xs.back() + (actual_x - previous);
+  y = std::clamp(y, row_ys_.front(), row_ys_.back());
+  return InvertPiecewiseLinear(row_xs_, [&](double x) { return map_.AxisDelta(TableAxis::X, x, y); }, actual_x);
 }
 
 // y_N(x_N, y_N + Delta-y) on the column at nominal x, as above.
 double PaperSolver::NominalYOnColumn(double actual_y, double x) const {
-  const std::vector<double>& ys = map_.ys(TableAxis::Y);
-  double previous = ys[0] + map_.AxisDelta(TableAxis::Y, x, ys[0]);
-  if (actual_y <= previous) return ys[0] + (actual_y - previous);
-  for (std::size_t j = 1; j < ys.size(); ++j) {
-    double here = ys[j] + map_.AxisDelta(TableAxis::Y, x, ys[j]);
-    if (actual_y <= here) {
-      return ys[j - 1] + (actual_y - previous) / (here - previous) * (ys[j] - ys[j - 1]);
-    }
-    previous = here;
-  }
-  return ys.back() + (actual_y - previous);
+  x = std::clamp(x, column_xs_.front(), column_xs_.back());
+  return InvertPiecewiseLinear(column_ys_, [&](double y) { return map_.AxisDelta(TableAxis::Y, x, y); }, actual_y);
 }
 
 // The interval of nominal x that gives the actual x on the rows within the
@@ -184,7 +209,7 @@ PaperSolver::Interval PaperSolver::StepX(double actual_x, Interval y) const {
     x.hi = std::max(x.hi, v);
   };
   include(y.hi);
-  for (double row_y : map_.ys(TableAxis::X)) {
+  for (double row_y : row_ys_) {
     if (row_y > y.lo && row_y < y.hi) include(row_y);
   }
   return x;
@@ -199,7 +224,7 @@ PaperSolver::Interval PaperSolver::StepY(double actual_y, Interval x) const {
     y.hi = std::max(y.hi, v);
   };
   include(x.hi);
-  for (double column_x : map_.xs(TableAxis::Y)) {
+  for (double column_x : column_xs_) {
     if (column_x > x.lo && column_x < x.hi) include(column_x);
   }
   return y;
@@ -207,9 +232,8 @@ PaperSolver::Interval PaperSolver::StepY(double actual_y, Interval x) const {
 
 Solution PaperSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const {
   SMTCAL_CHECK(std::isfinite(actual.x()) && std::isfinite(actual.y()), "solving for a non-finite point");
-  const std::vector<double>& rows = map_.ys(TableAxis::X);
   // Step 1: all nominal rows. Step 2: y within the x interval found.
-  Interval x = StepX(actual.x(), Interval{rows.front(), rows.back()});
+  Interval x = StepX(actual.x(), Interval{row_ys_.front(), row_ys_.back()});
   Interval y = StepY(actual.y(), x);
   int steps = 2;
   Eigen::Vector2d n;

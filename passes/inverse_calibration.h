@@ -19,6 +19,7 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -113,6 +114,12 @@ class PaperSolver {
   CalibrationMap map_;
   double tolerance_mm_;
   int max_steps_;
+  // The nodes of the discrete functions, within the domain (where F is
+  // defined): the domain's edges and the grid lines between them.
+  std::vector<double> row_xs_;  // x nodes of the x table's rows
+  std::vector<double> row_ys_;  // the x table's rows (nominal y)
+  std::vector<double> column_ys_;  // y nodes of the y table's columns
+  std::vector<double> column_xs_;  // the y table's columns (nominal x)
 };
 
 }  // namespace smtcal

@@ -136,7 +136,8 @@ class Dumper {
   std::string Point(const ir::PointExpr& p) {
     std::string out = fmt::format("(point{} ", Loc(p.loc));
     if (const auto* named = std::get_if<ir::NamedPoint>(&p.base)) {
-      out += fmt::format("(name{} {})", locations_ ? fmt::format(" /{}", named->length) : "", NameAtom(named->name));
+      std::string length = locations_ ? fmt::format(" /{}", named->length) : "";
+      out += fmt::format("(name{} {})", length, NameAtom(named->name));
     } else if (const auto* coords = std::get_if<ir::Coords>(&p.base)) {
       out += Coords(*coords);
     } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&p.base)) {
@@ -186,7 +187,8 @@ class Dumper {
     std::string at = Loc(stmt.loc, stmt.length);
     std::visit([&](const auto& node) { StmtNode(node, stmt, at, depth); }, stmt.node);
   }
-  void Simple(const std::string& head, const std::string& at, const std::string& fields, const ir::Stmt& stmt) {
+  void Simple(const std::string& head, const std::string& at, const std::string& fields,
+              const ir::Stmt& stmt) {
     out_ += "(" + head + at + fields + Common(stmt) + ")";
   }
 
@@ -206,8 +208,8 @@ class Dumper {
     Simple("local", at, " " + NameAtom(d.name) + " " + Coords(d.origin) + Frame(d.frame, d.frame_loc), s);
   }
   void StmtNode(const ir::PointDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("point-decl", at,
-           " " + NameAtom(d.name) + (d.taught ? " :taught " : " ") + Coords(d.coords) + Frame(d.frame, d.frame_loc), s);
+    std::string fields = " " + NameAtom(d.name) + (d.taught ? " :taught " : " ") + Coords(d.coords);
+    Simple("point-decl", at, fields + Frame(d.frame, d.frame_loc), s);
   }
   void StmtNode(const ir::PalletDecl& d, const ir::Stmt& s, const std::string& at, int) {
     std::string fields = fmt::format(" {}", d.number);

@@ -13,6 +13,11 @@ namespace smtcal {
 // point inside a valid table (DESIGN.md, "Numbers"). The iteration bound of a
 // table is derived for half of it, which leaves room for rounding.
 inline constexpr double kInverseResidualTolMm = 1e-9;
+// Within that bound the solver keeps going while the residual is above this:
+// machine precision for millimetre coordinates of a robot cell (the rounding
+// of n + Delta(n) - a is a few ulp of ~1000 mm, about 1e-13 mm). It also stops
+// when a step no longer makes progress, so larger coordinates are fine.
+inline constexpr double kInversePolishMm = 1e-12;
 
 // The paper's solver stops when the direct-calibrated interval means are this
 // close to the required point: the task tolerance of the basic assembly

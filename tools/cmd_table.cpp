@@ -98,7 +98,8 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
   TableStats stats = ComputeTableStats(*table);
   int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
   Finish(diags, options, "-",
-         opt.json ? FormatStatsJson(*table, stats, analysis, bound) : FormatStatsText(*table, stats, analysis, bound));
+         opt.json ? FormatStatsJson(*table, stats, analysis, bound)
+                  : FormatStatsText(*table, stats, analysis, bound));
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
@@ -135,8 +136,8 @@ void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
     SMTCAL_CHECK(paper || s.status != SolveStatus::kNotConverged,
                  "the default inverse solver exceeded the iteration bound proven for this table");
     if (s.status == SolveStatus::kOutside) {
-      std::string detail = inverse ? fmt::format("; the nominal position that reaches it would be ({}, {})",
-                                                 FormatMm(s.point.x()), FormatMm(s.point.y()))
+      std::string detail = inverse ? fmt::format("; the nominal position that reaches it would be ({:.6f}, {:.6f})",
+                                                 s.point.x(), s.point.y())
                                    : "";
       diags.Report(DiagKind::PointOutsideTable, row.range, FormatMm(row.point.x()), FormatMm(row.point.y()),
                    FormatMm(domain.x0), FormatMm(domain.x1), FormatMm(domain.y0), FormatMm(domain.y1), detail);

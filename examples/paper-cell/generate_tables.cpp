@@ -88,7 +88,9 @@ class Normal {
 // along y): a scale error, an out-of-squareness and a gentle bow, like a
 // Cartesian robot with a heavy gripper. Each has one minimum and one maximum
 // node; Shape() maps them to [0, 1] and the generator stretches that.
-double ShapeX(double u, double v) { return u + 0.6 * v + 0.3 * std::sin(std::numbers::pi * u) * (1 - v) + 0.15 * u * v * v; }
+double ShapeX(double u, double v) {
+  return u + 0.6 * v + 0.3 * std::sin(std::numbers::pi * u) * (1 - v) + 0.15 * u * v * v;
+}
 double ShapeY(double u, double v) {
   return 0.9 * v - 0.5 * u + 0.25 * std::sin(1.5 * std::numbers::pi * u) * (0.4 + v) + 0.1 * u * v;
 }
@@ -187,7 +189,8 @@ Axis MakeAxis(TableAxis which, double x0, double y0, Target target, Normal& norm
   for (double value : raw) axis.shape.push_back((value - lowest) / (highest - lowest));
   for (int j = 0; j < kNodes; ++j) {
     for (int i = 0; i < kNodes; ++i) {
-      axis.bump.push_back(std::sin(std::numbers::pi * i / (kNodes - 1)) * std::sin(std::numbers::pi * j / (kNodes - 1)));
+      double u = static_cast<double>(i) / (kNodes - 1), v = static_cast<double>(j) / (kNodes - 1);
+      axis.bump.push_back(std::sin(std::numbers::pi * u) * std::sin(std::numbers::pi * v));
     }
   }
   for (std::size_t k = 0; k < raw.size() * kMeasurements; ++k) axis.noise.push_back(normal());
@@ -258,13 +261,21 @@ int Run(const std::filesystem::path& dir) {
                s.min_mm * 1000, s.max_mm * 1000, s.mean_mm * 1000, axis.power);
   }
 
+  // The plot is of the table as written (6 decimals), as `smtcal table plot`
+  // reads it back.
+  const std::string table_text = FormatTableCsv(*table, BuiltTableComment("placing-raw.csv"));
+  std::optional<ErrorTable> written_table =
+      ReadErrorTable(sources.Add("placing-table.csv", table_text), diags);
+  if (!written_table) {
+    fmt::print(stderr, "generate_tables: the written table does not read back:\n{}", diags.RenderText());
+    return 1;
+  }
   struct Output {
     const char* name;
     std::string text;
   };
-  for (const Output& output : {Output{"placing-raw.csv", raw_text},
-                               Output{"placing-table.csv", FormatTableCsv(*table, BuiltTableComment("placing-raw.csv"))},
-                               Output{"placing-table.svg", PlotTableSvg(*table, "placing-table.csv")}}) {
+  for (const Output& output : {Output{"placing-raw.csv", raw_text}, Output{"placing-table.csv", table_text},
+                               Output{"placing-table.svg", PlotTableSvg(*written_table, "placing-table.csv")}}) {
     Status written = WriteFileAtomically((dir / output.name).string(), output.text);
     if (!written) {
       fmt::print(stderr, "generate_tables: {}\n", written.error().message);

@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "frontend/parse.h"
+#include "passes/pass_manager.h"
 #include "tests/bench/program_generator.h"
 
 namespace smtcal {
@@ -24,6 +25,10 @@ void BM_ParseAndCheck100kLines(benchmark::State& state) {
     std::uint32_t file = sources.Add("bench.place", text);
     Diagnostics diags(sources);
     ir::Program program = ParseProgram(file, diags);
+    if (!diags.has_errors()) {
+      Status status = RunPasses(program, diags, std::vector<std::string>{}, false);
+      if (!status) state.SkipWithError(status.error().message.c_str());
+    }
     benchmark::DoNotOptimize(program);
     errors = diags.error_count();
   }

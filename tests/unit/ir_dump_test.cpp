@@ -50,7 +50,8 @@ ir::Program EveryNode() {
   program.items.push_back(Stmt(ir::UnitsDecl{"mm"}));
   program.items.push_back(Stmt(ir::FixtureDecl{"Board"}));
   program.items.push_back(Stmt(ir::LocalDecl{"L1", ir::Coords{{1, 2, 0, 0}, {}}, "Board", {}}));
-  program.items.push_back(Stmt(ir::PointDecl{"U3", true, ir::Coords{{171.204, 97.311, -3, 0}, {}}, "Board", {}}));
+  program.items.push_back(
+      Stmt(ir::PointDecl{"U3", true, ir::Coords{{171.204, 97.311, -3, 0}, {}}, "Board", {}}));
   program.items.push_back(Stmt(ir::PointDecl{"Feed", false, ir::Coords{{0.1, -0.0, 1e21, 90}, {}}, "", {}}));
   program.items.push_back(Stmt(ir::PalletDecl{1, {"A", "B", "C"}, {}, 3, 4}));
   program.items.push_back(Stmt(ir::VacuumDecl{2}));
@@ -59,8 +60,9 @@ ir::Program EveryNode() {
   ir::Function main;
   main.name = "Main";
   main.body.push_back(Stmt(ir::VarDecl{ir::VarType::Integer, {"i"}, {}}));
+  ir::ExprPtr minus = Make(ir::UnaryExpr{ir::UnaryOp::Negate, Num(2.5, false)});
   main.body.push_back(
-      Stmt(ir::Assign{"x", Make(ir::BinaryExpr{ir::BinaryOp::Add, Num(1, true), Make(ir::UnaryExpr{ir::UnaryOp::Negate, Num(2.5, false)})})}));
+      Stmt(ir::Assign{"x", Make(ir::BinaryExpr{ir::BinaryOp::Add, Num(1, true), std::move(minus)})}));
   ir::Motion jump;
   jump.target = Named("P");
   ir::PointOffset offset;

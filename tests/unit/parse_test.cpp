@@ -339,7 +339,8 @@ const ErrorCase kErrors[] = {
      "    x = 1 $ 2\n"
      "          ^\n"},
     {"Function Main\n  Jump P\xC3\xA9\nFend\n",
-     "t.place:2:9: error: unexpected character '\xC3\xA9'; names use only the letters A-Z, digits and '_'\n"
+     "t.place:2:9: error: unexpected character '\xC3\xA9'; outside comments a program uses only plain ASCII "
+     "letters, digits and signs\n"
      "    Jump P\xC3\xA9\n"
      "          ^~\n"},
     {"Program A\nNext\n",
@@ -388,7 +389,8 @@ const ErrorCase kErrors[] = {
      "  x = 1\n"
      "  ^\n"},
     {"Function Main\n  Taught Point P = XY(0, 0, 0, 0)\nFend\n",
-     "t.place:2:3: error: 'Taught Point' declarations belong at the top of the program, outside Function Main\n"
+     "t.place:2:3: error: 'Taught Point' declarations belong at the top of the program, outside "
+     "Function Main\n"
      "    Taught Point P = XY(0, 0, 0, 0)\n"
      "    ^~~~~~\n"},
     {"Function Main\n  Jmp P\n  3 + 4\nFend\n",
@@ -469,7 +471,8 @@ const ErrorCase kErrors[] = {
      "  Point P = XY(1, a, 3, 4)\n"
      "                  ^\n"},
     {"Pallet 1, A, B, C, 3\n",
-     "t.place:1:21: error: expected ',' after '3', found end of line; write: Pallet n, P1, P2, P3, columns, rows\n"
+     "t.place:1:21: error: expected ',' after '3', found end of line; "
+     "write: Pallet n, P1, P2, P3, columns, rows\n"
      "  Pallet 1, A, B, C, 3\n"
      "                      ^\n"},
     // ---- checks on what parsed
@@ -597,6 +600,56 @@ TEST(ParseRobustness, RandomTokens) {
     }
     SCOPED_TRACE(fmt::format("round {}: {}", round, text.substr(0, 200)));
     ExpectQuietAndBounded(text);
+  }
+}
+
+// A mistake stays on its line: junk added to the end of any one line of a
+// valid program gives exactly one error, on that line, whatever the line is
+// (a block's first or last line included).
+TEST(ParseRobustness, JunkOnOneLineGivesOneErrorOnThatLine) {
+  const std::vector<std::string> lines = {
+      "Program LayerA",
+      "Units mm",
+      "Fixture Board",
+      "Point C1 = XY(12.70, 8.25, -3.00, 90) In Board",
+      "Pallet 1, C1, C1, C1, 3, 4",
+      "Function Main",
+      "  Integer i",
+      "  Cycle Board",
+      "    For i = 0 To 2 Step 1",
+      "      Pick Pallet(1, i) Vacuum 1",
+      "      Place C1 + X(i * 55.0) LimZ -3",
+      "    Next i",
+      "  EndCycle",
+      "  If Sw(1) = On Then",
+      "    Wait Sw(2) = Off",
+      "  ElseIf i > 2 Then",
+      "    On 3",
+      "  Else",
+      "    Call Other",
+      "  EndIf",
+      "Fend",
+      "Function Other()",
+      "  Exit Function",
+      "Fend"};
+  const std::vector<std::string> junk = {" 1 2", " )", " Foo Bar", " = =", " Next", " ,", " (", " 3",
+                                         " Jump", " Then", " + X", " .5 .5"};
+  std::uint32_t seed = 99;
+  SCOPED_TRACE(fmt::format("seed {}", seed));
+  std::mt19937 rng(seed);
+  for (std::size_t line = 0; line < lines.size(); ++line) {
+    for (int k = 0; k < 4; ++k) {
+      std::string added = junk[std::uniform_int_distribution<std::size_t>(0, junk.size() - 1)(rng)];
+      std::string text;
+      for (std::size_t i = 0; i < lines.size(); ++i) text += lines[i] + (i == line ? added : "") + "\n";
+      SourceManager sources;
+      std::uint32_t file = sources.Add("t.place", text);
+      Diagnostics diags(sources);
+      (void)ParseProgram(file, diags);
+      SCOPED_TRACE(fmt::format("line {}: '{}{}'", line + 1, lines[line], added));
+      ASSERT_EQ(diags.all().size(), 1u) << diags.RenderText();
+      EXPECT_EQ(diags.all()[0].range.begin.line, line + 1) << diags.RenderText();
+    }
   }
 }
 
