@@ -29,20 +29,46 @@ std::string Location(const SourceManager& sources, const SourceRange& range) {
   return fmt::format("{}:{}:{}", file.name, range.begin.line, range.begin.column);
 }
 
-// The quoted source line and a caret line under the range. Tabs are kept in
-// the caret line so the caret lines up in a terminal.
+// Length of the valid UTF-8 sequence starting at text[i], or 0 if invalid.
+std::size_t Utf8SequenceLength(std::string_view text, std::size_t i) {
+  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  unsigned char lead = byte(i);
+  std::size_t length = lead < 0x80 ? 1 : (lead >> 5) == 0x6 ? 2 : (lead >> 4) == 0xE ? 3
+                                   : (lead >> 3) == 0x1E ? 4 : 0;
+  if (length == 0 || i + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(i + k) & 0xC0) != 0x80) return 0;
+  }
+  return length;
+}
+
+// The quoted source line and a caret line under the range. The line is made
+// safe for a terminal (control characters and invalid UTF-8 bytes become
+// '?'), and the caret line advances one column per character, not per byte,
+// so the caret sits under the right character in UTF-8 text. Tabs are kept.
 void AppendSnippet(std::string& out, const SourceManager& sources, const SourceRange& range) {
   if (!range.begin.known()) return;
   std::string_view line = sources.File(range.begin.file).Line(range.begin.line);
-  out += fmt::format("  {}\n  ", line);
-  std::uint32_t column = std::max<std::uint32_t>(range.begin.column, 1);
-  for (std::uint32_t i = 1; i < column && i - 1 < line.size(); ++i) out += line[i - 1] == '\t' ? '\t' : ' ';
-  out += '^';
-  std::uint32_t available =
-      column - 1 < line.size() ? static_cast<std::uint32_t>(line.size()) - (column - 1) : 1;
-  std::uint32_t length = std::min(range.length, std::max<std::uint32_t>(available, 1));
-  for (std::uint32_t i = 1; i < length; ++i) out += '~';
-  out += '\n';
+  std::size_t begin = range.begin.column == 0 ? 0 : range.begin.column - 1;
+  std::size_t end = begin + std::max<std::uint32_t>(range.length, 1);
+  std::string shown;
+  std::string marks;
+  bool caret_placed = false;
+  for (std::size_t i = 0; i < line.size();) {
+    std::size_t length = Utf8SequenceLength(line, i);
+    unsigned char c = static_cast<unsigned char>(line[i]);
+    bool printable = length > 1 || (length == 1 && (c >= 0x20 || c == '\t') && c != 0x7F);
+    std::size_t step = length == 0 ? 1 : length;
+    shown += printable ? std::string(line.substr(i, step)) : std::string("?");
+    char mark = c == '\t' ? '\t' : ' ';
+    if (i >= begin && i < end) mark = caret_placed ? '~' : '^';
+    if (mark == '^') caret_placed = true;
+    marks += mark;
+    i += step;
+  }
+  if (!caret_placed) marks += '^';  // the range starts at the end of the line
+  while (!marks.empty() && (marks.back() == ' ' || marks.back() == '\t')) marks.pop_back();
+  out += fmt::format("  {}\n  {}\n", shown, marks);
 }
 
 }  // namespace

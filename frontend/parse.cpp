@@ -11,7 +11,9 @@
 //     the missing closers and cuts over-long expressions -- so ANTLR always
 //     sees well-nested blocks, its errors stay inside one line, and its
 //     recursion depth stays bounded.
-//  3. Parse with ANTLR. Errors are recovered at the end of their line
+//  3. Parse with ANTLR, one top-level line (a declaration or a whole
+//     Function) at a time, turning each into IR and freeing its parse tree
+//     before the next. Errors are recovered at the end of their line
 //     (LineErrorStrategy) and rewritten into plain words from the rule and
 //     the expected tokens (SyntaxErrorListener). One visitor (IrBuilder)
 //     builds the IR; a statement whose line has a syntax error is dropped.
@@ -1464,15 +1466,17 @@ ir::Program Session::Run() {
     IrBuilder builder(*this);
     IrBuilder::BlockWalker top(builder, 1);
     while (tokens.LA(1) != Token::EOF) {
+      std::size_t before = tokens.index();
       P::ProgramLineContext* line = parser.programLine();
       if (P::TopLevelContext* item = line->topLevel()) top.Add(item);
       parser.getTreeTracker().reset();
+      if (tokens.index() == before) parser.consume();  // never loop in place
     }
     program.items = top.Finish(last_line() + 1);
   } catch (const std::exception& e) {
     // ANTLR gave up in a way its recovery does not cover; say so plainly.
     Error(DiagKind::SyntaxError, SourceLoc{file_, 0, 0},
-          fmt::format("cannot parse this file ({}); fix the errors above first", e.what()));
+          fmt::format("the parser stopped ({}); fix the other errors and try again", e.what()));
   }
   Flush();
   return program;

