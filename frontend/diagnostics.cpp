@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -71,6 +72,27 @@ void AppendSnippet(std::string& out, const SourceManager& sources, const SourceR
   out += fmt::format("  {}\n  {}\n", shown, marks);
 }
 
+// Diagnostics in source order (file, line, column), whatever pass found them;
+// equal locations keep the order they were reported in. Diagnostics about a
+// whole file (no line) follow that file's located ones, and the
+// too-many-errors marker stays last: both are summaries.
+std::vector<const Diagnostic*> InSourceOrder(const std::vector<Diagnostic>& diagnostics) {
+  std::vector<const Diagnostic*> sorted;
+  for (const Diagnostic& diag : diagnostics) sorted.push_back(&diag);
+  std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic* a, const Diagnostic* b) {
+    bool a_last = a->kind == DiagKind::TooManyErrors;
+    bool b_last = b->kind == DiagKind::TooManyErrors;
+    if (a_last != b_last) return b_last;
+    const SourceLoc& x = a->range.begin;
+    const SourceLoc& y = b->range.begin;
+    bool x_whole_file = x.line == 0;
+    bool y_whole_file = y.line == 0;
+    return std::tie(x.file, x_whole_file, x.line, x.column) <
+           std::tie(y.file, y_whole_file, y.line, y.column);
+  });
+  return sorted;
+}
+
 }  // namespace
 
 std::string_view DiagKindName(DiagKind kind) { return Info(kind).name; }
@@ -104,7 +126,8 @@ Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string messa
 
 std::string Diagnostics::RenderText() const {
   std::string out;
-  for (const Diagnostic& diag : diagnostics_) {
+  for (const Diagnostic* sorted : InSourceOrder(diagnostics_)) {
+    const Diagnostic& diag = *sorted;
     out += fmt::format("{}: {}: {}\n", Location(sources_, diag.range), SeverityName(diag.severity),
                        diag.message);
     AppendSnippet(out, sources_, diag.range);
@@ -126,7 +149,8 @@ std::string Diagnostics::RenderJson() const {
     return j;
   };
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
-  for (const Diagnostic& diag : diagnostics_) {
+  for (const Diagnostic* sorted : InSourceOrder(diagnostics_)) {
+    const Diagnostic& diag = *sorted;
     nlohmann::ordered_json j;
     j["kind"] = DiagKindName(diag.kind);
     j["severity"] = SeverityName(diag.severity);

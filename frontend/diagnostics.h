@@ -66,6 +66,8 @@ class Diagnostics {
   const std::vector<Diagnostic>& all() const { return diagnostics_; }
   const SourceManager& sources() const { return sources_; }
 
+  // Both renderings list the diagnostics in source order (file, line,
+  // column), not in the order the passes found them.
   // GCC/Clang style: "file:line:col: error: message", the source line, a caret.
   std::string RenderText() const;
   // The same as a JSON array of objects (kind, severity, file, line, column,
