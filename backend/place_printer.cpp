@@ -6,7 +6,11 @@
 #include <string_view>
 #include <type_traits>
 
+#include <fmt/format.h>
+
 #include "frontend/check.h"
+#include "passes/ir_ops.h"
+#include "passes/symbols.h"
 
 namespace smtcal {
 namespace {
@@ -16,84 +20,17 @@ namespace {
 constexpr double kSmallestPlainReal = 1e-5;
 constexpr double kLargestPlainReal = 1e15;
 
-// Binding strength, from the grammar's expr rule (ANTLR gives the earlier
-// alternative the higher precedence). All binary operators are
-// left-associative. A unary operator's operand is a primary or another unary
-// expression, so `-a * b` is (-a) * b and `Not a = b` is (Not a) = b.
-enum Precedence : int {
-  kOrXor = 1,
-  kAnd = 2,
-  kComparison = 3,
-  kAdditive = 4,
-  kMultiplicative = 5,
-  kUnary = 6,
-  kPrimary = 7,
-};
-
-int BinaryPrecedence(ir::BinaryOp op) {
-  switch (op) {
-    case ir::BinaryOp::Or:
-    case ir::BinaryOp::Xor: return kOrXor;
-    case ir::BinaryOp::And: return kAnd;
-    case ir::BinaryOp::Eq:
-    case ir::BinaryOp::Ne:
-    case ir::BinaryOp::Lt:
-    case ir::BinaryOp::Gt:
-    case ir::BinaryOp::Le:
-    case ir::BinaryOp::Ge: return kComparison;
-    case ir::BinaryOp::Add:
-    case ir::BinaryOp::Sub: return kAdditive;
-    case ir::BinaryOp::Mul:
-    case ir::BinaryOp::Div:
-    case ir::BinaryOp::Mod: return kMultiplicative;
-  }
-  SMTCAL_CHECK(false, "unknown binary operator");
-  return 0;
-}
-
-std::string_view BinaryOpText(ir::BinaryOp op) {
-  switch (op) {
-    case ir::BinaryOp::Add: return "+";
-    case ir::BinaryOp::Sub: return "-";
-    case ir::BinaryOp::Mul: return "*";
-    case ir::BinaryOp::Div: return "/";
-    case ir::BinaryOp::Mod: return "Mod";
-    case ir::BinaryOp::Eq: return "=";
-    case ir::BinaryOp::Ne: return "<>";
-    case ir::BinaryOp::Lt: return "<";
-    case ir::BinaryOp::Gt: return ">";
-    case ir::BinaryOp::Le: return "<=";
-    case ir::BinaryOp::Ge: return ">=";
-    case ir::BinaryOp::And: return "And";
-    case ir::BinaryOp::Or: return "Or";
-    case ir::BinaryOp::Xor: return "Xor";
-  }
-  SMTCAL_CHECK(false, "unknown binary operator");
-  return "";
-}
-
 int ExprPrecedence(const ir::Expr& expr) {
   if (const auto* binary = std::get_if<ir::BinaryExpr>(&expr.node)) {
-    return BinaryPrecedence(binary->op);
+    return ir::BinaryOpPrecedence(binary->op);
   }
-  if (std::holds_alternative<ir::UnaryExpr>(expr.node)) return kUnary;
-  return kPrimary;
+  if (std::holds_alternative<ir::UnaryExpr>(expr.node)) return ir::kUnaryPrecedence;
+  return ir::kPrimaryPrecedence;
 }
 
 std::string Parenthesized(const ir::Expr& expr, bool parenthesize) {
   std::string text = PrintExpr(expr);
   return parenthesize ? "(" + text + ")" : text;
-}
-
-std::string_view AxisText(ir::Axis axis) {
-  switch (axis) {
-    case ir::Axis::X: return "X";
-    case ir::Axis::Y: return "Y";
-    case ir::Axis::Z: return "Z";
-    case ir::Axis::U: return "U";
-  }
-  SMTCAL_CHECK(false, "unknown axis");
-  return "";
 }
 
 std::string CoordsText(const ir::Coords& coords) {
@@ -103,15 +40,6 @@ std::string CoordsText(const ir::Coords& coords) {
     text += FormatRealLiteral(coords.values[i]);
   }
   return text + ")";
-}
-
-bool SameNameIgnoringCase(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
-    if (lower(a[i]) != lower(b[i])) return false;
-  }
-  return true;
 }
 
 class Printer {
@@ -198,15 +126,11 @@ class Printer {
           } else if constexpr (std::is_same_v<Node, ir::Assign>) {
             Line(depth, node.name + " = " + PrintExpr(*node.value), comment);
           } else if constexpr (std::is_same_v<Node, ir::Motion>) {
-            std::string text = node.kind == ir::MotionKind::Jump ? "Jump "
-                               : node.kind == ir::MotionKind::Go ? "Go "
-                                                                 : "Move ";
-            text += PrintPointExpr(node.target);
+            std::string text = std::string(ir::MotionSpelling(node.kind)) + " " + PrintPointExpr(node.target);
             if (node.limz) text += " LimZ " + PrintExpr(*node.limz);
             Line(depth, text, comment);
           } else if constexpr (std::is_same_v<Node, ir::PickPlace>) {
-            std::string text = node.kind == ir::PickPlaceKind::Pick ? "Pick " : "Place ";
-            text += PrintPointExpr(node.target);
+            std::string text = std::string(ir::PickPlaceSpelling(node.kind)) + " " + PrintPointExpr(node.target);
             if (node.vacuum) text += " Vacuum " + PrintExpr(*node.vacuum);
             if (node.limz) text += " LimZ " + PrintExpr(*node.limz);
             Line(depth, text, comment);
@@ -228,7 +152,7 @@ class Printer {
             // `Next` always names its loop variable, spelled as in the For
             // line; a Next naming some other variable is the user's mistake,
             // kept as written for the checker to report.
-            bool names_other = !node.next_var.empty() && !SameNameIgnoringCase(node.next_var, node.var);
+            bool names_other = !node.next_var.empty() && !sema::SameName(node.next_var, node.var);
             End(depth, "Next " + (names_other ? node.next_var : node.var), node.end);
           } else if constexpr (std::is_same_v<Node, ir::If>) {
             for (std::size_t i = 0; i < node.branches.size(); ++i) {
@@ -316,22 +240,18 @@ std::string PrintExpr(const ir::Expr& expr) {
           return node.on ? "On" : "Off";
         } else if constexpr (std::is_same_v<Node, ir::UnaryExpr>) {
           SMTCAL_CHECK(node.operand != nullptr, "unary expression without operand");
-          std::string operand = Parenthesized(*node.operand, ExprPrecedence(*node.operand) < kUnary);
-          switch (node.op) {
-            case ir::UnaryOp::Negate: return "-" + operand;
-            case ir::UnaryOp::Plus: return "+" + operand;
-            case ir::UnaryOp::Not: return "Not " + operand;
-          }
-          SMTCAL_CHECK(false, "unknown unary operator");
-          return "";
+          std::string operand = Parenthesized(*node.operand, ExprPrecedence(*node.operand) < ir::kUnaryPrecedence);
+          // Not is a word and needs a space before its operand; - and + do not.
+          std::string_view space = node.op == ir::UnaryOp::Not ? " " : "";
+          return fmt::format("{}{}{}", ir::UnaryOpSpelling(node.op), space, operand);
         } else if constexpr (std::is_same_v<Node, ir::BinaryExpr>) {
           SMTCAL_CHECK(node.lhs != nullptr && node.rhs != nullptr, "binary expression without operand");
           // Left-associative: the left operand needs parentheses only when it
           // binds looser, the right one also when it binds equally
           // (a - (b - c) keeps them, (a - b) - c does not).
-          int precedence = BinaryPrecedence(node.op);
+          int precedence = ir::BinaryOpPrecedence(node.op);
           return Parenthesized(*node.lhs, ExprPrecedence(*node.lhs) < precedence) + " " +
-                 std::string(BinaryOpText(node.op)) + " " +
+                 std::string(ir::BinaryOpSpelling(node.op)) + " " +
                  Parenthesized(*node.rhs, ExprPrecedence(*node.rhs) <= precedence);
         } else if constexpr (std::is_same_v<Node, ir::SwitchRead>) {
           SMTCAL_CHECK(node.bit != nullptr, "Sw() without a bit");
@@ -364,7 +284,7 @@ std::string PrintPointExpr(const ir::PointExpr& point) {
   for (const ir::PointOffset& offset : point.offsets) {
     SMTCAL_CHECK(offset.amount != nullptr, "point offset without an amount");
     text += offset.negative ? " - " : " + ";
-    text += AxisText(offset.axis);
+    text += ir::AxisSpelling(offset.axis);
     text += "(" + PrintExpr(*offset.amount) + ")";
   }
   return text;
@@ -383,7 +303,7 @@ void ApplyCanonicalChanges(ir::Block& block) {
           if constexpr (std::is_same_v<Node, ir::Function> || std::is_same_v<Node, ir::Cycle>) {
             ApplyCanonicalChanges(node.body);
           } else if constexpr (std::is_same_v<Node, ir::For>) {
-            if (node.next_var.empty() || SameNameIgnoringCase(node.next_var, node.var)) {
+            if (node.next_var.empty() || sema::SameName(node.next_var, node.var)) {
               node.next_var = node.var;
             }
             ApplyCanonicalChanges(node.body);

@@ -165,7 +165,8 @@ std::string Diagnostics::RenderJson() const {
     j["notes"] = std::move(notes);
     list.push_back(std::move(j));
   }
-  return list.dump(2) + "\n";
+  // replace: a message quoting invalid UTF-8 from the input must not throw.
+  return list.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 std::string ClosestName(std::string_view name, const std::vector<std::string>& candidates) {

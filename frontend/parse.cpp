@@ -995,10 +995,15 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
   SourceLoc Loc(antlr4::tree::TerminalNode* node) const {
     return node == nullptr ? SourceLoc{} : s_.Loc(node->getSymbol());
   }
+  // The text of the comment on `line`, without its ' and without spaces or
+  // tabs at its end: they are invisible, and printing them back would end a
+  // canonical line in whitespace. Spaces after the ' are kept as written.
   std::string CommentOn(std::size_t line) const {
     const Line* info = s_.LineAt(line);
     if (info == nullptr || info->comment == nullptr) return {};
-    return std::string(s_.Text(info->comment).substr(1));
+    std::string_view text = s_.Text(info->comment).substr(1);
+    std::size_t end = text.find_last_not_of(" \t");
+    return std::string(text.substr(0, end == std::string_view::npos ? 0 : end + 1));
   }
   // A new statement located at ctx's first token.
   ir::StmtPtr NewStmt(antlr4::ParserRuleContext* ctx) {
@@ -1086,15 +1091,15 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
   // ---- top level
   // programDecl : PROGRAM ID ;
   antlrcpp::Any visitProgramDecl(P::ProgramDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::ProgramDecl{Name(ctx->ID())}));
+    return Yield(MakeStmt(ctx, ir::ProgramDecl{Name(ctx->ID()), Loc(ctx->ID())}));
   }
   // unitsDecl : UNITS ID ;
   antlrcpp::Any visitUnitsDecl(P::UnitsDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::UnitsDecl{Name(ctx->ID())}));
+    return Yield(MakeStmt(ctx, ir::UnitsDecl{Name(ctx->ID()), Loc(ctx->ID())}));
   }
   // fixtureDecl : FIXTURE ID ;
   antlrcpp::Any visitFixtureDecl(P::FixtureDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::FixtureDecl{Name(ctx->ID())}));
+    return Yield(MakeStmt(ctx, ir::FixtureDecl{Name(ctx->ID()), Loc(ctx->ID())}));
   }
   // localDecl : LOCAL ID '=' coords (IN ID)? ;
   antlrcpp::Any visitLocalDecl(P::LocalDeclContext* ctx) override {
@@ -1102,6 +1107,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     if (!coords) return Yield(ir::StmtPtr());
     ir::LocalDecl decl;
     decl.name = Name(ctx->ID(0));
+    decl.name_loc = Loc(ctx->ID(0));
     decl.origin = *coords;
     decl.frame = Name(ctx->ID(1));
     decl.frame_loc = Loc(ctx->ID(1));
@@ -1113,6 +1119,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     if (!coords) return Yield(ir::StmtPtr());
     ir::PointDecl decl;
     decl.name = Name(ctx->ID(0));
+    decl.name_loc = Loc(ctx->ID(0));
     decl.taught = ctx->TAUGHT() != nullptr;
     decl.coords = *coords;
     decl.frame = Name(ctx->ID(1));
@@ -1131,17 +1138,21 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     if (ctx->NUMBER().size() != 3 || ctx->ID().size() != 3) return Yield(ir::StmtPtr());
     ir::PalletDecl decl;
     decl.number = WholeNumber(ctx->NUMBER(0), "the pallet number");
+    decl.number_loc = Loc(ctx->NUMBER(0));
     for (std::size_t i = 0; i < 3; ++i) {
       decl.corners[i] = Name(ctx->ID(i));
       decl.corner_locs[i] = Loc(ctx->ID(i));
     }
     decl.columns = WholeNumber(ctx->NUMBER(1), "the number of pallet columns");
+    decl.columns_loc = Loc(ctx->NUMBER(1));
     decl.rows = WholeNumber(ctx->NUMBER(2), "the number of pallet rows");
+    decl.rows_loc = Loc(ctx->NUMBER(2));
     return Yield(MakeStmt(ctx, std::move(decl)));
   }
   // vacuumDecl : VACUUM NUMBER ;
   antlrcpp::Any visitVacuumDecl(P::VacuumDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->NUMBER(), "the vacuum output")}));
+    return Yield(
+        MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->NUMBER(), "the vacuum output"), Loc(ctx->NUMBER())}));
   }
   // varDecl : (INTEGER | REAL) ID (',' ID)* ;
   antlrcpp::Any visitVarDecl(P::VarDeclContext* ctx) override {
@@ -1159,6 +1170,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     if (ctx->functionHead() == nullptr) return Yield(ir::StmtPtr());
     ir::Function function;
     function.name = Name(ctx->functionHead()->ID());
+    function.name_loc = Loc(ctx->functionHead()->ID());
     std::uint32_t head = StartLine(ctx);
     function.body = Body(ctx->block(), head + 1, LineOf(ctx->FEND(), StopLine(ctx) + 1));
     function.end = End(ctx->FEND());
@@ -1192,6 +1204,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
                                            : ir::MotionKind::Jump;
     motion.target = std::move(*target);
     motion.limz = Expr(ctx->expr());
+    motion.limz_loc = Loc(ctx->LIMZ());
     return Yield(MakeStmt(ctx, std::move(motion)));
   }
   // pickPlace : (PICK | PLACE) pointExpr (VACUUM expr)? (LIMZ expr)? ;
@@ -1246,6 +1259,7 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     loop.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->NEXT(), StopLine(ctx) + 1));
     loop.end = End(ctx->NEXT());
     loop.next_var = Name(ctx->ID());
+    loop.next_var_loc = Loc(ctx->ID());
     return Yield(MakeStmt(ctx, std::move(loop)));
   }
   // ifStmt     : ifHead block elseIfPart* elsePart? ENDIF ;
@@ -1292,20 +1306,21 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
   }
   // callStmt : CALL ID ('(' ')')? ;
   antlrcpp::Any visitCallStmt(P::CallStmtContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::Call{Name(ctx->ID())}));
+    return Yield(MakeStmt(ctx, ir::Call{Name(ctx->ID()), Loc(ctx->ID())}));
   }
   // cycleStmt : cycleHead block ENDCYCLE ;    cycleHead : CYCLE ID NEWLINE ;
   antlrcpp::Any visitCycleStmt(P::CycleStmtContext* ctx) override {
     if (ctx->cycleHead() == nullptr) return Yield(ir::StmtPtr());
     ir::Cycle cycle;
     cycle.fixture = Name(ctx->cycleHead()->ID());
+    cycle.fixture_loc = Loc(ctx->cycleHead()->ID());
     cycle.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->ENDCYCLE(), StopLine(ctx) + 1));
     cycle.end = End(ctx->ENDCYCLE());
     return Yield(MakeStmt(ctx, std::move(cycle)));
   }
   // scanStmt : SCAN ID ;
   antlrcpp::Any visitScanStmt(P::ScanStmtContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::Scan{Name(ctx->ID())}));
+    return Yield(MakeStmt(ctx, ir::Scan{Name(ctx->ID()), Loc(ctx->ID())}));
   }
   // exitStmt : EXIT FUNCTION ;
   antlrcpp::Any visitExitStmt(P::ExitStmtContext* ctx) override {

@@ -64,7 +64,7 @@ class CheckFixtureScope final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program, diags.sources());
+    sema::SymbolTable table = sema::SymbolTable::Build(program);
     table_ = &table;
 
     std::vector<const ir::Function*> functions;
@@ -112,7 +112,7 @@ class CheckFixtureScope final : public Pass {
       const auto& b = std::get<ir::PointDecl>(corner->decl->node);
       Diagnostic* diag = diags_->Report(
           DiagKind::PalletCornersInDifferentFrames,
-          SourceRange(pallet.corner_locs[i], static_cast<std::uint32_t>(pallet.corners[i].size())),
+          sema::NameAt(pallet.corner_locs[i], pallet.corners[i]),
           pallet.number, first->name, DescribeFrame(a), corner->name, DescribeFrame(b));
       Diagnostics::AddNote(diag, corner->range, fmt::format("'{}' is declared here", corner->name));
       return;  // one report per pallet
@@ -151,9 +151,9 @@ class CheckFixtureScope final : public Pass {
       auto it = arrivals_.find(std::make_pair(function, context.Key()));
       if (it == arrivals_.end() || it->second.call == nullptr) return;
       const Arrival& arrival = it->second;
-      const ir::Stmt& call = *arrival.call;
-      const std::string& callee = std::get<ir::Call>(call.node).name;
-      SourceRange where = sema::NameRange(diags_->sources(), call.loc, callee);
+      const auto& call = std::get<ir::Call>(arrival.call->node);
+      const std::string& callee = call.name;
+      SourceRange where = sema::NameAt(call.name_loc, call.name);
       if (arrival.call_inside_cycle) {
         Diagnostics::AddNote(diag, where, fmt::format("'{}' is called here, {}", callee, Where(context)));
         return;
@@ -215,7 +215,7 @@ class CheckFixtureScope final : public Pass {
   }
 
   void CycleStmt(const ir::Stmt& stmt, const ir::Cycle& inner, const ir::Stmt* outer) {
-    SourceRange where = sema::NameRange(diags_->sources(), stmt.loc, inner.fixture);
+    SourceRange where = sema::NameAt(inner.fixture_loc, inner.fixture);
     if (outer != nullptr) {
       if (!FirstReport(stmt)) return;
       const std::string& outer_name = std::get<ir::Cycle>(outer->node).fixture;
@@ -233,7 +233,7 @@ class CheckFixtureScope final : public Pass {
     if (context.kind != Context::Kind::Cycle || sema::SameName(context.fixture, scan.fixture)) return;
     const Symbol* scanned = table_->Find(scan.fixture);
     if (scanned == nullptr || scanned->kind != SymbolKind::Fixture || !FirstReport(stmt)) return;
-    SourceRange where = sema::NameRange(diags_->sources(), stmt.loc, scan.fixture);
+    SourceRange where = sema::NameAt(scan.fixture_loc, scan.fixture);
     if (cycle != nullptr) {
       Diagnostic* diag = diags_->Report(DiagKind::ScanInOtherCycle, where, scan.fixture, context.fixture, "");
       Diagnostics::AddNote(diag, sema::StmtRange(*cycle), "the Cycle starts here");

@@ -16,7 +16,6 @@ class CheckHeader final : public Pass {
   std::string_view Name() const override { return "check-header"; }
 
   void Run(ir::Program& program, Diagnostics& diags) override {
-    const SourceManager& sources = diags.sources();
     const ir::Stmt* first = nullptr;
     const ir::Stmt* program_decl = nullptr;
     const ir::Stmt* units_decl = nullptr;
@@ -45,8 +44,7 @@ class CheckHeader final : public Pass {
         }
       } else if (const auto* units = std::get_if<ir::UnitsDecl>(&stmt.node)) {
         if (once(stmt, units_decl, "Units") && !sema::SameName(units->unit, "mm")) {
-          diags.Report(DiagKind::UnsupportedUnit, sema::NameRange(sources, stmt.loc, units->unit),
-                       units->unit);
+          diags.Report(DiagKind::UnsupportedUnit, sema::NameAt(units->unit_loc, units->unit), units->unit);
         }
       } else if (std::holds_alternative<ir::VacuumDecl>(stmt.node)) {
         once(stmt, vacuum_decl, "Vacuum");

@@ -17,6 +17,8 @@
 
 #include "passes/checks.h"
 #include "passes/constant_fold.h"
+#include "passes/ir_ops.h"
+#include "passes/ir_walk.h"
 #include "passes/limits.h"
 #include "passes/symbols.h"
 
@@ -55,23 +57,13 @@ bool Fits(Want want, SymbolKind kind) {
   return false;
 }
 
-const char* MotionWord(ir::MotionKind kind) {
-  switch (kind) {
-    case ir::MotionKind::Jump: return "Jump";
-    case ir::MotionKind::Go: return "Go";
-    case ir::MotionKind::Move: return "Move";
-  }
-  return "a motion";
-}
-
 class CheckNames final : public Pass {
  public:
   std::string_view Name() const override { return "check-names"; }
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sources_ = &diags.sources();
-    sema::SymbolTable table = sema::SymbolTable::Build(program, *sources_);
+    sema::SymbolTable table = sema::SymbolTable::Build(program);
     table_ = &table;
     for (const ir::StmtPtr& item : program.items) TopLevel(*item);
   }
@@ -81,17 +73,17 @@ class CheckNames final : public Pass {
 
   void TopLevel(const ir::Stmt& stmt) {
     if (const auto* fixture = std::get_if<ir::FixtureDecl>(&stmt.node)) {
-      Definition(stmt, fixture->name);
+      Definition(stmt, fixture->name, fixture->name_loc);
     } else if (const auto* local = std::get_if<ir::LocalDecl>(&stmt.node)) {
-      Definition(stmt, local->name);
+      Definition(stmt, local->name, local->name_loc);
       if (!local->frame.empty()) {
-        GlobalUse(local->frame, FrameRange(local->frame_loc, local->frame), Want::Frame, "'In'");
+        GlobalUse(local->frame, sema::NameAt(local->frame_loc, local->frame), Want::Frame, "'In'");
         LocalLoop(stmt, *local);
       }
     } else if (const auto* point = std::get_if<ir::PointDecl>(&stmt.node)) {
-      Definition(stmt, point->name);
+      Definition(stmt, point->name, point->name_loc);
       if (!point->frame.empty()) {
-        SourceRange where = FrameRange(point->frame_loc, point->frame);
+        SourceRange where = sema::NameAt(point->frame_loc, point->frame);
         if (point->taught) {
           GlobalUse(point->frame, where, Want::Fixture, "a taught point's 'On'");
         } else {
@@ -106,7 +98,7 @@ class CheckNames final : public Pass {
                              fmt::format("pallet {} was first defined here", pallet->number));
       }
       for (std::size_t i = 0; i < pallet->corners.size(); ++i) {
-        GlobalUse(pallet->corners[i], FrameRange(pallet->corner_locs[i], pallet->corners[i]), Want::Point,
+        GlobalUse(pallet->corners[i], sema::NameAt(pallet->corner_locs[i], pallet->corners[i]), Want::Point,
                   "a pallet corner");
       }
     } else if (std::holds_alternative<ir::VarDecl>(stmt.node)) {
@@ -114,19 +106,15 @@ class CheckNames final : public Pass {
         Definition(variable);
       }
     } else if (const auto* function = std::get_if<ir::Function>(&stmt.node)) {
-      Definition(stmt, function->name);
+      Definition(stmt, function->name, function->name_loc);
       FunctionBody(*function);
     }
   }
 
-  static SourceRange FrameRange(SourceLoc loc, const std::string& name) {
-    return SourceRange(loc, static_cast<std::uint32_t>(name.size()));
-  }
-
-  void Definition(const ir::Stmt& stmt, const std::string& name) {
+  void Definition(const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
     Symbol mine;
     mine.name = name;
-    mine.range = sema::NameRange(*sources_, stmt.loc, name);
+    mine.range = sema::NameAt(name_loc, name);
     mine.decl = &stmt;
     Definition(mine);
   }
@@ -169,7 +157,7 @@ class CheckNames final : public Pass {
       reported_loops_.insert(chain[i]);
       if (i == 0) continue;
       const auto& decl = std::get<ir::LocalDecl>(chain[i]->decl->node);
-      Diagnostics::AddNote(diag, FrameRange(decl.frame_loc, decl.frame),
+      Diagnostics::AddNote(diag, sema::NameAt(decl.frame_loc, decl.frame),
                            fmt::format("'{}' is given In '{}' here", chain[i]->name, decl.frame));
     }
   }
@@ -240,24 +228,15 @@ class CheckNames final : public Pass {
   void FunctionBody(const ir::Function& function) {
     sema::LocalScope scope(*table_);
     scope_ = &scope;
+    // Every local the function declares anywhere, for "declared later" notes.
     all_locals_.clear();
-    CollectLocals(function.body);
-    Block(function.body);
-    scope_ = nullptr;
-  }
-
-  // Every local the function declares anywhere, for "declared later" notes.
-  void CollectLocals(const ir::Block& block) {
-    for (const ir::StmtPtr& stmt : block) {
-      for (Symbol& local : sema::VariablesDeclaredBy(*stmt, /*global=*/false)) {
+    ir::ForEachStmt(function.body, [&](const ir::Stmt& stmt) {
+      for (Symbol& local : sema::VariablesDeclaredBy(stmt, /*global=*/false)) {
         all_locals_.emplace(sema::Lowercase(local.name), std::move(local));
       }
-      if (const auto* loop = std::get_if<ir::For>(&stmt->node)) CollectLocals(loop->body);
-      if (const auto* branch = std::get_if<ir::If>(&stmt->node)) {
-        for (const ir::IfBranch& b : branch->branches) CollectLocals(b.body);
-      }
-      if (const auto* cycle = std::get_if<ir::Cycle>(&stmt->node)) CollectLocals(cycle->body);
-    }
+    });
+    Block(function.body);
+    scope_ = nullptr;
   }
 
   void Block(const ir::Block& block) {
@@ -279,14 +258,13 @@ class CheckNames final : public Pass {
         }
       }
     } else if (const auto* assign = std::get_if<ir::Assign>(&stmt.node)) {
-      ScopedUse(assign->name, sema::NameRange(*sources_, stmt.loc, assign->name), Want::Variable,
-                "an assignment");
+      ScopedUse(assign->name, sema::NameAt(stmt.loc, assign->name), Want::Variable, "an assignment");
       Expr(assign->value.get());
     } else if (const auto* motion = std::get_if<ir::Motion>(&stmt.node)) {
-      Point(motion->target, MotionWord(motion->kind));
+      Point(motion->target, ir::MotionSpelling(motion->kind));
       Expr(motion->limz.get());
     } else if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
-      Point(pick->target, pick->kind == ir::PickPlaceKind::Pick ? "Pick" : "Place");
+      Point(pick->target, ir::PickPlaceSpelling(pick->kind));
       Expr(pick->vacuum.get());
       Expr(pick->limz.get());
     } else if (const auto* output = std::get_if<ir::SetOutput>(&stmt.node)) {
@@ -296,7 +274,7 @@ class CheckNames final : public Pass {
     } else if (const auto* wait_sw = std::get_if<ir::WaitSwitch>(&stmt.node)) {
       Expr(wait_sw->bit.get());
     } else if (const auto* loop = std::get_if<ir::For>(&stmt.node)) {
-      ScopedUse(loop->var, FrameRange(loop->var_loc, loop->var), Want::Variable, "For");
+      ScopedUse(loop->var, sema::NameAt(loop->var_loc, loop->var), Want::Variable, "For");
       Expr(loop->from.get());
       Expr(loop->to.get());
       Expr(loop->step.get());
@@ -307,12 +285,12 @@ class CheckNames final : public Pass {
         Block(b.body);
       }
     } else if (const auto* call = std::get_if<ir::Call>(&stmt.node)) {
-      ScopedUse(call->name, sema::NameRange(*sources_, stmt.loc, call->name), Want::Function, "Call");
+      ScopedUse(call->name, sema::NameAt(call->name_loc, call->name), Want::Function, "Call");
     } else if (const auto* cycle = std::get_if<ir::Cycle>(&stmt.node)) {
-      ScopedUse(cycle->fixture, sema::NameRange(*sources_, stmt.loc, cycle->fixture), Want::Fixture, "Cycle");
+      ScopedUse(cycle->fixture, sema::NameAt(cycle->fixture_loc, cycle->fixture), Want::Fixture, "Cycle");
       Block(cycle->body);
     } else if (const auto* scan = std::get_if<ir::Scan>(&stmt.node)) {
-      ScopedUse(scan->fixture, sema::NameRange(*sources_, stmt.loc, scan->fixture), Want::Fixture, "Scan");
+      ScopedUse(scan->fixture, sema::NameAt(scan->fixture_loc, scan->fixture), Want::Fixture, "Scan");
     }
   }
 
@@ -338,21 +316,14 @@ class CheckNames final : public Pass {
   }
 
   void Expr(const ir::Expr* expr) {
-    if (expr == nullptr) return;
-    if (const auto* variable = std::get_if<ir::VariableRef>(&expr->node)) {
-      ScopedUse(variable->name, sema::ExprRange(*expr), Want::Variable, "an expression");
-    } else if (const auto* unary = std::get_if<ir::UnaryExpr>(&expr->node)) {
-      Expr(unary->operand.get());
-    } else if (const auto* binary = std::get_if<ir::BinaryExpr>(&expr->node)) {
-      Expr(binary->lhs.get());
-      Expr(binary->rhs.get());
-    } else if (const auto* sw = std::get_if<ir::SwitchRead>(&expr->node)) {
-      Expr(sw->bit.get());
-    }
+    ir::ForEachExpr(expr, [&](const ir::Expr& node) {
+      if (const auto* variable = std::get_if<ir::VariableRef>(&node.node)) {
+        ScopedUse(variable->name, sema::ExprRange(node), Want::Variable, "an expression");
+      }
+    });
   }
 
   Diagnostics* diags_ = nullptr;
-  const SourceManager* sources_ = nullptr;
   const sema::SymbolTable* table_ = nullptr;
   sema::LocalScope* scope_ = nullptr;
   std::map<std::string, Symbol> all_locals_;

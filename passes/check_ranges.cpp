@@ -15,6 +15,8 @@
 
 #include "passes/checks.h"
 #include "passes/constant_fold.h"
+#include "passes/ir_ops.h"
+#include "passes/ir_walk.h"
 #include "passes/limits.h"
 #include "passes/symbols.h"
 
@@ -27,7 +29,7 @@ class CheckRanges final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program, diags.sources());
+    sema::SymbolTable table = sema::SymbolTable::Build(program);
     table_ = &table;
     for (const ir::StmtPtr& item : program.items) {
       if (std::holds_alternative<ir::VacuumDecl>(item->node)) has_default_vacuum_ = true;
@@ -36,19 +38,19 @@ class CheckRanges final : public Pass {
   }
 
  private:
-  // The range of a number written in `stmt` after `after`, for carets.
-  SourceRange NumberRange(SourceLoc after, int value) const {
-    return sema::NameRange(diags_->sources(), after, std::to_string(value));
+  // A whole number written at `loc`: the caret underlines its digits.
+  static SourceRange NumberAt(SourceLoc loc, int value) {
+    return SourceRange(loc, static_cast<std::uint32_t>(std::to_string(value).size()));
   }
 
   void TopLevel(const ir::Stmt& stmt) {
     if (const auto* vacuum = std::get_if<ir::VacuumDecl>(&stmt.node)) {
       if (vacuum->output < limits::kVacuumOutputMin || vacuum->output > limits::kVacuumOutputMax) {
-        diags_->Report(DiagKind::VacuumOutputOutOfRange, NumberRange(stmt.loc, vacuum->output), vacuum->output,
-                       limits::kVacuumOutputMin, limits::kVacuumOutputMax);
+        diags_->Report(DiagKind::VacuumOutputOutOfRange, NumberAt(vacuum->output_loc, vacuum->output),
+                       vacuum->output, limits::kVacuumOutputMin, limits::kVacuumOutputMax);
       }
     } else if (const auto* pallet = std::get_if<ir::PalletDecl>(&stmt.node)) {
-      Pallet(stmt, *pallet);
+      Pallet(*pallet);
     } else if (const auto* local = std::get_if<ir::LocalDecl>(&stmt.node)) {
       Angle(local->origin);
     } else if (const auto* point = std::get_if<ir::PointDecl>(&stmt.node)) {
@@ -58,21 +60,18 @@ class CheckRanges final : public Pass {
     }
   }
 
-  void Pallet(const ir::Stmt& stmt, const ir::PalletDecl& pallet) {
+  void Pallet(const ir::PalletDecl& pallet) {
     if (pallet.number < limits::kPalletNumberMin || pallet.number > limits::kPalletNumberMax) {
-      diags_->Report(DiagKind::PalletNumberOutOfRange, NumberRange(stmt.loc, pallet.number), pallet.number,
-                     limits::kPalletNumberMin, limits::kPalletNumberMax);
+      diags_->Report(DiagKind::PalletNumberOutOfRange, NumberAt(pallet.number_loc, pallet.number),
+                     pallet.number, limits::kPalletNumberMin, limits::kPalletNumberMax);
     }
-    // Columns and rows follow the last corner on the line.
-    SourceRange columns = NumberRange(pallet.corner_locs[2], pallet.columns);
     if (pallet.columns < limits::kPalletMinColumns) {
-      diags_->Report(DiagKind::PalletSizeInvalid, columns, pallet.number, pallet.columns, "columns");
+      diags_->Report(DiagKind::PalletSizeInvalid, NumberAt(pallet.columns_loc, pallet.columns), pallet.number,
+                     pallet.columns, "columns");
     }
     if (pallet.rows < limits::kPalletMinRows) {
-      SourceLoc after = columns.begin;
-      after.column += columns.length;
-      diags_->Report(DiagKind::PalletSizeInvalid, NumberRange(after, pallet.rows), pallet.number, pallet.rows,
-                     "rows");
+      diags_->Report(DiagKind::PalletSizeInvalid, NumberAt(pallet.rows_loc, pallet.rows), pallet.number,
+                     pallet.rows, "rows");
     }
   }
 
@@ -96,21 +95,18 @@ class CheckRanges final : public Pass {
       Point(motion->target);
       Expr(motion->limz.get());
       if (motion->limz != nullptr && motion->kind != ir::MotionKind::Jump) {
-        const char* kind = motion->kind == ir::MotionKind::Go ? "Go" : "Move";
-        SourceRange where = sema::NameRange(diags_->sources(), stmt.loc, "LimZ");
-        if (where.begin == stmt.loc) where = sema::ExprRange(*motion->limz);
-        diags_->Report(DiagKind::LimZNotAllowed, where, kind);
+        diags_->Report(DiagKind::LimZNotAllowed, sema::NameAt(motion->limz_loc, "LimZ"),
+                       ir::MotionSpelling(motion->kind));
       }
     } else if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
       Point(pick->target);
       Expr(pick->vacuum.get());
       Expr(pick->limz.get());
-      const char* kind = pick->kind == ir::PickPlaceKind::Pick ? "Pick" : "Place";
       if (pick->vacuum != nullptr) {
         Bit(pick->vacuum.get(), DiagKind::VacuumOutputOutOfRange, limits::kVacuumOutputMin,
             limits::kVacuumOutputMax);
       } else if (!has_default_vacuum_) {
-        diags_->Report(DiagKind::MissingVacuumOutput, sema::StmtRange(stmt), kind);
+        diags_->Report(DiagKind::MissingVacuumOutput, sema::StmtRange(stmt), ir::PickPlaceSpelling(pick->kind));
       }
     } else if (const auto* output = std::get_if<ir::SetOutput>(&stmt.node)) {
       Expr(output->bit.get());
@@ -188,16 +184,11 @@ class CheckRanges final : public Pass {
 
   // Sw(n) reads anywhere in an expression.
   void Expr(const ir::Expr* expr) {
-    if (expr == nullptr) return;
-    if (const auto* sw = std::get_if<ir::SwitchRead>(&expr->node)) {
-      Expr(sw->bit.get());
-      Bit(sw->bit.get(), DiagKind::IoBitOutOfRange, limits::kIoBitMin, limits::kIoBitMax);
-    } else if (const auto* unary = std::get_if<ir::UnaryExpr>(&expr->node)) {
-      Expr(unary->operand.get());
-    } else if (const auto* binary = std::get_if<ir::BinaryExpr>(&expr->node)) {
-      Expr(binary->lhs.get());
-      Expr(binary->rhs.get());
-    }
+    ir::ForEachExpr(expr, [&](const ir::Expr& node) {
+      if (const auto* sw = std::get_if<ir::SwitchRead>(&node.node)) {
+        Bit(sw->bit.get(), DiagKind::IoBitOutOfRange, limits::kIoBitMin, limits::kIoBitMax);
+      }
+    });
   }
 
   Diagnostics* diags_ = nullptr;

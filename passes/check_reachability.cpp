@@ -19,6 +19,7 @@
 #include <set>
 
 #include "passes/checks.h"
+#include "passes/ir_walk.h"
 #include "passes/symbols.h"
 
 namespace smtcal {
@@ -44,14 +45,14 @@ class CheckReachability final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program, diags.sources());
+    sema::SymbolTable table = sema::SymbolTable::Build(program);
     table_ = &table;
     std::vector<const ir::Stmt*> functions;
     for (const ir::StmtPtr& item : program.items) {
       if (const auto* function = std::get_if<ir::Function>(&item->node)) {
         functions.push_back(item.get());
         FunctionBody(*function);
-        CollectCalls(function, function->body);
+        CollectCalls(*function);
       }
     }
     Unused(functions);
@@ -115,21 +116,15 @@ class CheckReachability final : public Pass {
 
   // ---------------------------------------------------------------- calls
 
-  void CollectCalls(const ir::Function* caller, const ir::Block& block) {
-    for (const ir::StmtPtr& stmt : block) {
-      if (const auto* call = std::get_if<ir::Call>(&stmt->node)) {
-        const Symbol* callee = table_->Find(call->name);
-        if (callee != nullptr && callee->kind == SymbolKind::Function) {
-          calls_[caller].push_back({stmt.get(), &std::get<ir::Function>(callee->decl->node)});
-        }
-      } else if (const auto* loop = std::get_if<ir::For>(&stmt->node)) {
-        CollectCalls(caller, loop->body);
-      } else if (const auto* branch = std::get_if<ir::If>(&stmt->node)) {
-        for (const ir::IfBranch& b : branch->branches) CollectCalls(caller, b.body);
-      } else if (const auto* cycle = std::get_if<ir::Cycle>(&stmt->node)) {
-        CollectCalls(caller, cycle->body);
+  void CollectCalls(const ir::Function& caller) {
+    ir::ForEachStmt(caller.body, [&](const ir::Stmt& stmt) {
+      const auto* call = std::get_if<ir::Call>(&stmt.node);
+      if (call == nullptr) return;
+      const Symbol* callee = table_->Find(call->name);
+      if (callee != nullptr && callee->kind == SymbolKind::Function) {
+        calls_[&caller].push_back({&stmt, &std::get<ir::Function>(callee->decl->node)});
       }
-    }
+    });
   }
 
   void Unused(const std::vector<const ir::Stmt*>& functions) {
@@ -142,8 +137,7 @@ class CheckReachability final : public Pass {
     for (const ir::Stmt* stmt : functions) {
       const auto& function = std::get<ir::Function>(stmt->node);
       if (sema::SameName(function.name, "Main") || called.count(&function) != 0) continue;
-      diags_->Report(DiagKind::UnusedFunction, sema::NameRange(diags_->sources(), stmt->loc, function.name),
-                     function.name);
+      diags_->Report(DiagKind::UnusedFunction, sema::NameAt(function.name_loc, function.name), function.name);
     }
   }
 
@@ -183,9 +177,9 @@ class CheckReachability final : public Pass {
     std::string path;
     for (const Frame& frame : cycle) path += fmt::format("'{}' -> ", frame.function->name);
     path += fmt::format("'{}'", target->name);
-    const SourceManager& sources = diags_->sources();
-    auto call_range = [&](const Frame& frame) {
-      return sema::NameRange(sources, frame.call->loc, std::get<ir::Call>(frame.call->node).name);
+    auto call_range = [](const Frame& frame) {
+      const auto& call = std::get<ir::Call>(frame.call->node);
+      return sema::NameAt(call.name_loc, call.name);
     };
     Diagnostic* diag = diags_->Report(DiagKind::RecursiveCall, call_range(cycle.front()), path);
     for (std::size_t i = 1; i < cycle.size(); ++i) {

@@ -17,6 +17,7 @@
 // - `Next v` names its For's variable.
 // Reads the IR, never changes it.
 #include "passes/checks.h"
+#include "passes/ir_ops.h"
 #include "passes/symbols.h"
 
 namespace smtcal {
@@ -40,26 +41,6 @@ const char* TypeWithArticle(Type type) {
 
 bool IsNumber(Type type) { return type == Type::Integer || type == Type::Real; }
 
-const char* OpName(ir::BinaryOp op) {
-  switch (op) {
-    case ir::BinaryOp::Add: return "+";
-    case ir::BinaryOp::Sub: return "-";
-    case ir::BinaryOp::Mul: return "*";
-    case ir::BinaryOp::Div: return "/";
-    case ir::BinaryOp::Mod: return "Mod";
-    case ir::BinaryOp::Eq: return "=";
-    case ir::BinaryOp::Ne: return "<>";
-    case ir::BinaryOp::Lt: return "<";
-    case ir::BinaryOp::Gt: return ">";
-    case ir::BinaryOp::Le: return "<=";
-    case ir::BinaryOp::Ge: return ">=";
-    case ir::BinaryOp::And: return "And";
-    case ir::BinaryOp::Or: return "Or";
-    case ir::BinaryOp::Xor: return "Xor";
-  }
-  return "?";
-}
-
 constexpr const char* kCompareHint = "; compare it, e.g. 'x <> 0'";
 
 class CheckTypes final : public Pass {
@@ -68,7 +49,7 @@ class CheckTypes final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program, diags.sources());
+    sema::SymbolTable table = sema::SymbolTable::Build(program);
     for (const ir::StmtPtr& item : program.items) {
       const auto* function = std::get_if<ir::Function>(&item->node);
       if (function == nullptr) continue;
@@ -107,13 +88,13 @@ class CheckTypes final : public Pass {
         }
         return operand == Type::Boolean ? Type::Boolean : Type::Unknown;
       }
-      const char* op = unary->op == ir::UnaryOp::Negate ? "-" : "+";
-      return Operand(*unary->operand, operand, op, /*want_number=*/true) ? operand : Type::Unknown;
+      return Operand(*unary->operand, operand, ir::UnaryOpSpelling(unary->op), /*want_number=*/true) ? operand
+                                                                                                 : Type::Unknown;
     }
     const auto& binary = std::get<ir::BinaryExpr>(expr.node);
     Type lhs = TypeOf(*binary.lhs);
     Type rhs = TypeOf(*binary.rhs);
-    const char* op = OpName(binary.op);
+    std::string_view op = ir::BinaryOpSpelling(binary.op);
     switch (binary.op) {
       case ir::BinaryOp::Add:
       case ir::BinaryOp::Sub:
@@ -157,7 +138,7 @@ class CheckTypes final : public Pass {
 
   // Whether an operand of `op` has the type it needs (numbers, or Boolean);
   // reports it when not. Unknown operands were reported elsewhere.
-  bool Operand(const ir::Expr& operand, Type type, const char* op, bool want_number) {
+  bool Operand(const ir::Expr& operand, Type type, std::string_view op, bool want_number) {
     if (type == Type::Unknown) return false;
     if (IsNumber(type) == want_number) return true;
     diags_->Report(DiagKind::OperandType, sema::ExprRange(operand), op, want_number ? "number" : "Boolean",
@@ -165,7 +146,7 @@ class CheckTypes final : public Pass {
     return false;
   }
 
-  bool IntegerOperand(const ir::Expr& operand, Type type, const char* op) {
+  bool IntegerOperand(const ir::Expr& operand, Type type, std::string_view op) {
     if (type == Type::Unknown) return false;
     if (type == Type::Integer) return true;
     diags_->Report(DiagKind::OperandType, sema::ExprRange(operand), op, "Integer", TypeName(type), "");
@@ -267,10 +248,9 @@ class CheckTypes final : public Pass {
     bound(loop.step, "the For step");
     Block(loop.body);
     if (!loop.next_var.empty() && !sema::SameName(loop.next_var, loop.var)) {
-      Diagnostic* diag = diags_->Report(DiagKind::NextMismatch,
-                                        sema::NameRange(diags_->sources(), loop.end.loc, loop.next_var),
+      Diagnostic* diag = diags_->Report(DiagKind::NextMismatch, sema::NameAt(loop.next_var_loc, loop.next_var),
                                         loop.next_var, loop.var, loop.var);
-      Diagnostics::AddNote(diag, SourceRange(loop.var_loc, static_cast<std::uint32_t>(loop.var.size())),
+      Diagnostics::AddNote(diag, sema::NameAt(loop.var_loc, loop.var),
                            fmt::format("the For of '{}' is here", loop.var));
     }
   }

@@ -89,6 +89,11 @@ struct PointExpr {
 };
 
 // ------------------------------------------------------------------ statements
+//
+// Names and numbers that a diagnostic may underline keep the location of
+// their first byte (`name_loc`, `frame_loc`, ...); the caret's length is the
+// name's length, or the number of digits of a number. A name that is the
+// statement's first token (an assignment's variable) uses Stmt::loc.
 
 struct Stmt;
 using StmtPtr = std::unique_ptr<Stmt>;
@@ -106,21 +111,26 @@ struct Comment {  // a line holding only a comment; text without the leading '
 };
 struct ProgramDecl {
   std::string name;
+  SourceLoc name_loc;
 };
 struct UnitsDecl {
   std::string unit;  // as written; only "mm" is valid
+  SourceLoc unit_loc;
 };
 struct FixtureDecl {
   std::string name;
+  SourceLoc name_loc;
 };
 struct LocalDecl {  // Local NAME = XY(...) [In FRAME]
   std::string name;
+  SourceLoc name_loc;
   Coords origin;
   std::string frame;  // empty = robot base
   SourceLoc frame_loc;
 };
 struct PointDecl {  // [Taught] Point NAME = XY(...) [In FRAME | On FIXTURE]
   std::string name;
+  SourceLoc name_loc;
   bool taught = false;
   Coords coords;
   std::string frame;  // empty = robot base; for taught points, the fixture
@@ -128,13 +138,17 @@ struct PointDecl {  // [Taught] Point NAME = XY(...) [In FRAME | On FIXTURE]
 };
 struct PalletDecl {  // Pallet n, P1, P2, P3, columns, rows
   int number = 0;
+  SourceLoc number_loc;
   std::array<std::string, 3> corners;
   std::array<SourceLoc, 3> corner_locs;
   int columns = 0;
+  SourceLoc columns_loc;
   int rows = 0;
+  SourceLoc rows_loc;
 };
 struct VacuumDecl {  // Vacuum n: default vacuum output for Pick/Place
   int output = 0;
+  SourceLoc output_loc;
 };
 enum class VarType { Integer, Real };
 struct VarDecl {
@@ -144,11 +158,12 @@ struct VarDecl {
 };
 struct Function {
   std::string name;
+  SourceLoc name_loc;
   Block body;
   BlockEnd end;  // the Fend line
 };
 struct Assign {
-  std::string name;
+  std::string name;  // the statement's first token: at Stmt::loc
   ExprPtr value;
 };
 enum class MotionKind { Jump, Go, Move };
@@ -156,6 +171,7 @@ struct Motion {
   MotionKind kind = MotionKind::Jump;
   PointExpr target;
   ExprPtr limz;  // may be null
+  SourceLoc limz_loc;  // the LimZ keyword: only Jump may have one
 };
 enum class PickPlaceKind { Pick, Place };
 struct PickPlace {
@@ -182,6 +198,7 @@ struct For {
   Block body;
   BlockEnd end;
   std::string next_var;  // as written after Next (may be empty)
+  SourceLoc next_var_loc;
 };
 struct IfBranch {
   SourceLoc loc;
@@ -197,14 +214,17 @@ struct If {
 };
 struct Call {
   std::string name;
+  SourceLoc name_loc;
 };
 struct Cycle {
   std::string fixture;
+  SourceLoc fixture_loc;
   Block body;
   BlockEnd end;
 };
 struct Scan {
   std::string fixture;
+  SourceLoc fixture_loc;
 };
 struct ExitFunction {};
 

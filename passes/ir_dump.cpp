@@ -1,6 +1,11 @@
 #include "passes/ir_dump.h"
 
+#include <cctype>
+#include <string_view>
+
 #include <fmt/format.h>
+
+#include "passes/ir_ops.h"
 
 namespace smtcal {
 namespace {
@@ -41,26 +46,16 @@ std::string NameAtom(const std::string& name) { return IsBareName(name) ? name :
 
 std::string Number(double value) { return fmt::format("{}", value); }
 
-std::string_view BinaryName(ir::BinaryOp op) {
-  switch (op) {
-    case ir::BinaryOp::Add: return "+";
-    case ir::BinaryOp::Sub: return "-";
-    case ir::BinaryOp::Mul: return "*";
-    case ir::BinaryOp::Div: return "/";
-    case ir::BinaryOp::Mod: return "mod";
-    case ir::BinaryOp::Eq: return "=";
-    case ir::BinaryOp::Ne: return "<>";
-    case ir::BinaryOp::Lt: return "<";
-    case ir::BinaryOp::Gt: return ">";
-    case ir::BinaryOp::Le: return "<=";
-    case ir::BinaryOp::Ge: return ">=";
-    case ir::BinaryOp::And: return "and";
-    case ir::BinaryOp::Or: return "or";
-    case ir::BinaryOp::Xor: return "xor";
-  }
-  return "?";
+// Operators and axes print as the language spells them, in lower case like
+// every head word of the dump: (+ a b), (mod a b), (and a b), (+x d).
+std::string Lower(std::string_view spelling) {
+  std::string lower(spelling);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower;
 }
 
+// Unary operators get words of their own, so (neg a) never reads as a
+// binary minus.
 std::string_view UnaryName(ir::UnaryOp op) {
   switch (op) {
     case ir::UnaryOp::Negate: return "neg";
@@ -68,16 +63,6 @@ std::string_view UnaryName(ir::UnaryOp op) {
     case ir::UnaryOp::Not: return "not";
   }
   return "?";
-}
-
-char AxisName(ir::Axis axis) {
-  switch (axis) {
-    case ir::Axis::X: return 'x';
-    case ir::Axis::Y: return 'y';
-    case ir::Axis::Z: return 'z';
-    case ir::Axis::U: return 'u';
-  }
-  return '?';
 }
 
 class Dumper {
@@ -122,7 +107,7 @@ class Dumper {
     return fmt::format("({}{} {})", UnaryName(u.op), at, Expr(u.operand));
   }
   std::string ExprNode(const ir::BinaryExpr& b, const std::string& at) {
-    return fmt::format("({}{} {} {})", BinaryName(b.op), at, Expr(b.lhs), Expr(b.rhs));
+    return fmt::format("({}{} {} {})", Lower(ir::BinaryOpSpelling(b.op)), at, Expr(b.lhs), Expr(b.rhs));
   }
   std::string ExprNode(const ir::SwitchRead& s, const std::string& at) {
     return fmt::format("(sw{} {})", at, Expr(s.bit));
@@ -146,8 +131,8 @@ class Dumper {
       out += ")";
     }
     for (const ir::PointOffset& offset : p.offsets) {
-      out += fmt::format(" ({}{}{} {})", offset.negative ? '-' : '+', AxisName(offset.axis), Loc(offset.loc),
-                         Expr(offset.amount));
+      out += fmt::format(" ({}{}{} {})", offset.negative ? '-' : '+', Lower(ir::AxisSpelling(offset.axis)),
+                         Loc(offset.loc), Expr(offset.amount));
     }
     return out + ")";
   }
@@ -196,29 +181,30 @@ class Dumper {
     Simple("comment", at, " " + Quoted(c.text), s);
   }
   void StmtNode(const ir::ProgramDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("program-decl", at, " " + NameAtom(d.name), s);
+    Simple("program-decl", at, " " + NameAtom(d.name) + Loc(d.name_loc), s);
   }
   void StmtNode(const ir::UnitsDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("units", at, " " + NameAtom(d.unit), s);
+    Simple("units", at, " " + NameAtom(d.unit) + Loc(d.unit_loc), s);
   }
   void StmtNode(const ir::FixtureDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("fixture", at, " " + NameAtom(d.name), s);
+    Simple("fixture", at, " " + NameAtom(d.name) + Loc(d.name_loc), s);
   }
   void StmtNode(const ir::LocalDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("local", at, " " + NameAtom(d.name) + " " + Coords(d.origin) + Frame(d.frame, d.frame_loc), s);
+    Simple("local", at,
+           " " + NameAtom(d.name) + Loc(d.name_loc) + " " + Coords(d.origin) + Frame(d.frame, d.frame_loc), s);
   }
   void StmtNode(const ir::PointDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    std::string fields = " " + NameAtom(d.name) + (d.taught ? " :taught " : " ") + Coords(d.coords);
+    std::string fields = " " + NameAtom(d.name) + Loc(d.name_loc) + (d.taught ? " :taught " : " ") + Coords(d.coords);
     Simple("point-decl", at, fields + Frame(d.frame, d.frame_loc), s);
   }
   void StmtNode(const ir::PalletDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    std::string fields = fmt::format(" {}", d.number);
+    std::string fields = fmt::format(" {}{}", d.number, Loc(d.number_loc));
     for (std::size_t i = 0; i < 3; ++i) fields += " " + NameAtom(d.corners[i]) + Loc(d.corner_locs[i]);
-    fields += fmt::format(" {} {}", d.columns, d.rows);
+    fields += fmt::format(" {}{} {}{}", d.columns, Loc(d.columns_loc), d.rows, Loc(d.rows_loc));
     Simple("pallet-decl", at, fields, s);
   }
   void StmtNode(const ir::VacuumDecl& d, const ir::Stmt& s, const std::string& at, int) {
-    Simple("vacuum-decl", at, fmt::format(" {}", d.output), s);
+    Simple("vacuum-decl", at, fmt::format(" {}{}", d.output, Loc(d.output_loc)), s);
   }
   void StmtNode(const ir::VarDecl& d, const ir::Stmt& s, const std::string& at, int) {
     std::string fields;
@@ -229,7 +215,7 @@ class Dumper {
     Simple(d.type == ir::VarType::Real ? "real" : "integer", at, fields, s);
   }
   void StmtNode(const ir::Function& f, const ir::Stmt& s, const std::string& at, int depth) {
-    out_ += "(function" + at + " " + NameAtom(f.name) + Common(s);
+    out_ += "(function" + at + " " + NameAtom(f.name) + Loc(f.name_loc) + Common(s);
     Block(f.body, depth + 1);
     out_ += "\n" + std::string(2 * (depth + 1), ' ') + End(f.end) + ")";
   }
@@ -237,11 +223,12 @@ class Dumper {
     Simple("assign", at, " " + NameAtom(a.name) + " " + Expr(a.value), s);
   }
   void StmtNode(const ir::Motion& m, const ir::Stmt& s, const std::string& at, int) {
-    const char* head = m.kind == ir::MotionKind::Jump ? "jump" : m.kind == ir::MotionKind::Go ? "go" : "move";
-    Simple(head, at, " " + Point(m.target) + Optional("limz", m.limz), s);
+    std::string head = Lower(ir::MotionSpelling(m.kind));
+    std::string limz = m.limz ? fmt::format(" :limz{} {}", Loc(m.limz_loc), Expr(m.limz)) : std::string();
+    Simple(head, at, " " + Point(m.target) + limz, s);
   }
   void StmtNode(const ir::PickPlace& p, const ir::Stmt& s, const std::string& at, int) {
-    Simple(p.kind == ir::PickPlaceKind::Pick ? "pick" : "place", at,
+    Simple(Lower(ir::PickPlaceSpelling(p.kind)), at,
            " " + Point(p.target) + Optional("vacuum", p.vacuum) + Optional("limz", p.limz), s);
   }
   void StmtNode(const ir::SetOutput& o, const ir::Stmt& s, const std::string& at, int) {
@@ -256,7 +243,7 @@ class Dumper {
   void StmtNode(const ir::For& f, const ir::Stmt& s, const std::string& at, int depth) {
     out_ += "(for" + at + " " + NameAtom(f.var) + Loc(f.var_loc) + " " + Expr(f.from) + " " + Expr(f.to) +
             Optional("step", f.step);
-    if (!f.next_var.empty()) out_ += " :next " + NameAtom(f.next_var);
+    if (!f.next_var.empty()) out_ += " :next " + NameAtom(f.next_var) + Loc(f.next_var_loc);
     out_ += Common(s);
     Block(f.body, depth + 1);
     out_ += "\n" + std::string(2 * (depth + 1), ' ') + End(f.end) + ")";
@@ -274,15 +261,15 @@ class Dumper {
     out_ += "\n" + indent + End(f.end) + ")";
   }
   void StmtNode(const ir::Call& c, const ir::Stmt& s, const std::string& at, int) {
-    Simple("call", at, " " + NameAtom(c.name), s);
+    Simple("call", at, " " + NameAtom(c.name) + Loc(c.name_loc), s);
   }
   void StmtNode(const ir::Cycle& c, const ir::Stmt& s, const std::string& at, int depth) {
-    out_ += "(cycle" + at + " " + NameAtom(c.fixture) + Common(s);
+    out_ += "(cycle" + at + " " + NameAtom(c.fixture) + Loc(c.fixture_loc) + Common(s);
     Block(c.body, depth + 1);
     out_ += "\n" + std::string(2 * (depth + 1), ' ') + End(c.end) + ")";
   }
   void StmtNode(const ir::Scan& c, const ir::Stmt& s, const std::string& at, int) {
-    Simple("scan", at, " " + NameAtom(c.fixture), s);
+    Simple("scan", at, " " + NameAtom(c.fixture) + Loc(c.fixture_loc), s);
   }
   void StmtNode(const ir::ExitFunction&, const ir::Stmt& s, const std::string& at, int) {
     Simple("exit-function", at, "", s);

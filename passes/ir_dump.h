@@ -17,7 +17,8 @@
 // ":blank" (a blank line precedes the statement). Whole-number literals print
 // as (int 1), others as (real 1.5). With locations, each node with a
 // SourceLoc gets "@file:line:column" after its head word, plus "/length"
-// where the node has a length.
+// where the node has a length; a name, number or keyword with a location of
+// its own gets it right after itself ("Board @1:3:9", ":limz @1:8:12 ...").
 #pragma once
 
 #include <string>

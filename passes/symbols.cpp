@@ -6,10 +6,6 @@
 namespace smtcal::sema {
 namespace {
 
-bool IsIdentifierChar(char c) {
-  return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
-}
-
 char LowerChar(char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); }
 
 }  // namespace
@@ -42,20 +38,8 @@ bool SameName(std::string_view a, std::string_view b) {
          std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return LowerChar(x) == LowerChar(y); });
 }
 
-SourceRange NameRange(const SourceManager& sources, SourceLoc start, std::string_view name) {
-  auto length = static_cast<std::uint32_t>(name.size());
-  if (!start.known() || name.empty()) return SourceRange(start, length);
-  std::string_view line = sources.File(start.file).Line(start.line);
-  for (std::size_t at = start.column == 0 ? 0 : start.column - 1; at + name.size() <= line.size(); ++at) {
-    if (line[at] == '\'') break;  // the rest of the line is a comment
-    if (!SameName(line.substr(at, name.size()), name)) continue;
-    bool starts_word = at == 0 || !IsIdentifierChar(line[at - 1]);
-    bool ends_word = at + name.size() == line.size() || !IsIdentifierChar(line[at + name.size()]);
-    if (starts_word && ends_word) {
-      return SourceRange(SourceLoc{start.file, start.line, static_cast<std::uint32_t>(at + 1)}, length);
-    }
-  }
-  return SourceRange(start, length);
+SourceRange NameAt(SourceLoc loc, std::string_view name) {
+  return SourceRange(loc, static_cast<std::uint32_t>(name.size()));
 }
 
 SourceRange StmtRange(const ir::Stmt& stmt) { return SourceRange(stmt.loc, stmt.length); }
@@ -70,7 +54,7 @@ std::vector<Symbol> VariablesDeclaredBy(const ir::Stmt& stmt, bool global) {
     symbol.kind = SymbolKind::Variable;
     symbol.name = decl->names[i];
     SourceLoc loc = i < decl->name_locs.size() ? decl->name_locs[i] : stmt.loc;
-    symbol.range = SourceRange(loc, static_cast<std::uint32_t>(decl->names[i].size()));
+    symbol.range = NameAt(loc, decl->names[i]);
     symbol.decl = &stmt;
     symbol.var_type = decl->type;
     symbol.global = global;
@@ -81,13 +65,13 @@ std::vector<Symbol> VariablesDeclaredBy(const ir::Stmt& stmt, bool global) {
 
 // ------------------------------------------------------------------ SymbolTable
 
-SymbolTable SymbolTable::Build(const ir::Program& program, const SourceManager& sources) {
+SymbolTable SymbolTable::Build(const ir::Program& program) {
   SymbolTable table;
-  auto named = [&](SymbolKind kind, const ir::Stmt& stmt, const std::string& name) {
+  auto named = [&](SymbolKind kind, const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
     Symbol symbol;
     symbol.kind = kind;
     symbol.name = name;
-    symbol.range = NameRange(sources, stmt.loc, name);
+    symbol.range = NameAt(name_loc, name);
     symbol.decl = &stmt;
     table.Add(std::move(symbol));
   };
@@ -95,13 +79,13 @@ SymbolTable SymbolTable::Build(const ir::Program& program, const SourceManager& 
     if (item == nullptr) continue;
     const ir::Stmt& stmt = *item;
     if (const auto* fixture = std::get_if<ir::FixtureDecl>(&stmt.node)) {
-      named(SymbolKind::Fixture, stmt, fixture->name);
+      named(SymbolKind::Fixture, stmt, fixture->name, fixture->name_loc);
     } else if (const auto* local = std::get_if<ir::LocalDecl>(&stmt.node)) {
-      named(SymbolKind::Local, stmt, local->name);
+      named(SymbolKind::Local, stmt, local->name, local->name_loc);
     } else if (const auto* point = std::get_if<ir::PointDecl>(&stmt.node)) {
-      named(SymbolKind::Point, stmt, point->name);
+      named(SymbolKind::Point, stmt, point->name, point->name_loc);
     } else if (const auto* function = std::get_if<ir::Function>(&stmt.node)) {
-      named(SymbolKind::Function, stmt, function->name);
+      named(SymbolKind::Function, stmt, function->name, function->name_loc);
     } else if (std::holds_alternative<ir::VarDecl>(stmt.node)) {
       for (Symbol& variable : VariablesDeclaredBy(stmt, /*global=*/true)) table.Add(std::move(variable));
     } else if (const auto* pallet = std::get_if<ir::PalletDecl>(&stmt.node)) {

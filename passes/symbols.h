@@ -40,11 +40,9 @@ std::string DescribeKind(const Symbol& symbol);
 std::string Lowercase(std::string_view name);
 bool SameName(std::string_view a, std::string_view b);
 
-// The range of `name` on the line of `start`, searching from start's column
-// (whole words, case-insensitive). The IR keeps only a statement's first
-// token for most declarations; this finds the name itself so the caret
-// underlines it. Falls back to `start` when the name is not on that line.
-SourceRange NameRange(const SourceManager& sources, SourceLoc start, std::string_view name);
+// The range of `name` written at `loc` (names are kept as written, so the
+// caret underlines exactly the name).
+SourceRange NameAt(SourceLoc loc, std::string_view name);
 // The range of a statement's first token.
 SourceRange StmtRange(const ir::Stmt& stmt);
 SourceRange ExprRange(const ir::Expr& expr);
@@ -69,7 +67,7 @@ class SymbolTable {
   };
 
   // Collects the top-level declarations of `program` (not function locals).
-  static SymbolTable Build(const ir::Program& program, const SourceManager& sources);
+  static SymbolTable Build(const ir::Program& program);
 
   const Symbol* Find(std::string_view name) const;
   // First definitions, in source order.

@@ -69,6 +69,11 @@ class Verifier {
   void Name(const ir::Stmt& stmt, const std::string& name, const char* what) {
     if (name.empty()) Issue(stmt, fmt::format("{} is empty", what));
   }
+  // A name the checks may underline: not empty, and its location known.
+  void Name(const ir::Stmt& stmt, const std::string& name, SourceLoc loc, const char* what) {
+    Name(stmt, name, what);
+    Known(StmtName(stmt), loc, what);
+  }
   void Required(const ir::Stmt& stmt, const ir::ExprPtr& expr, const char* what) {
     if (expr == nullptr) {
       Issue(stmt, fmt::format("{} is null", what));
@@ -159,26 +164,26 @@ class Verifier {
   }
 
   void Node(const ir::Stmt&, const ir::Comment&) {}
-  void Node(const ir::Stmt& s, const ir::ProgramDecl& n) { Name(s, n.name, "the program name"); }
-  void Node(const ir::Stmt& s, const ir::UnitsDecl& n) { Name(s, n.unit, "the unit"); }
-  void Node(const ir::Stmt& s, const ir::FixtureDecl& n) { Name(s, n.name, "the fixture name"); }
+  void Node(const ir::Stmt& s, const ir::ProgramDecl& n) { Name(s, n.name, n.name_loc, "the program name"); }
+  void Node(const ir::Stmt& s, const ir::UnitsDecl& n) { Name(s, n.unit, n.unit_loc, "the unit"); }
+  void Node(const ir::Stmt& s, const ir::FixtureDecl& n) { Name(s, n.name, n.name_loc, "the fixture name"); }
   void Node(const ir::Stmt& s, const ir::LocalDecl& n) {
-    Name(s, n.name, "the Local frame name");
+    Name(s, n.name, n.name_loc, "the Local frame name");
     Coords(StmtName(s), n.origin);
     if (!n.frame.empty()) Known(StmtName(s), n.frame_loc, "the frame name");
   }
   void Node(const ir::Stmt& s, const ir::PointDecl& n) {
-    Name(s, n.name, "the point name");
+    Name(s, n.name, n.name_loc, "the point name");
     Coords(StmtName(s), n.coords);
     if (!n.frame.empty()) Known(StmtName(s), n.frame_loc, "the frame name");
   }
   void Node(const ir::Stmt& s, const ir::PalletDecl& n) {
-    for (std::size_t i = 0; i < n.corners.size(); ++i) {
-      Name(s, n.corners[i], "a pallet corner name");
-      Known(StmtName(s), n.corner_locs[i], "a pallet corner");
-    }
+    Known(StmtName(s), n.number_loc, "the pallet number");
+    for (std::size_t i = 0; i < n.corners.size(); ++i) Name(s, n.corners[i], n.corner_locs[i], "a pallet corner");
+    Known(StmtName(s), n.columns_loc, "the number of columns");
+    Known(StmtName(s), n.rows_loc, "the number of rows");
   }
-  void Node(const ir::Stmt&, const ir::VacuumDecl&) {}
+  void Node(const ir::Stmt& s, const ir::VacuumDecl& n) { Known(StmtName(s), n.output_loc, "the vacuum output"); }
   void Node(const ir::Stmt& s, const ir::VarDecl& n) {
     if (n.names.empty()) Issue(s, "declares no names");
     if (n.names.size() != n.name_locs.size()) {
@@ -188,7 +193,7 @@ class Verifier {
     for (SourceLoc loc : n.name_locs) Known(StmtName(s), loc, "a variable name");
   }
   void Node(const ir::Stmt& s, const ir::Function& n) {
-    Name(s, n.name, "the function name");
+    Name(s, n.name, n.name_loc, "the function name");
     Block(s, n.body);
     End(s, n.end);
   }
@@ -199,6 +204,7 @@ class Verifier {
   void Node(const ir::Stmt& s, const ir::Motion& n) {
     Point(s, n.target);
     Optional(n.limz);
+    if (n.limz != nullptr) Known(StmtName(s), n.limz_loc, "the LimZ keyword");
   }
   void Node(const ir::Stmt& s, const ir::PickPlace& n) {
     Point(s, n.target);
@@ -209,13 +215,13 @@ class Verifier {
   void Node(const ir::Stmt& s, const ir::WaitTime& n) { Required(s, n.seconds, "the wait time"); }
   void Node(const ir::Stmt& s, const ir::WaitSwitch& n) { Required(s, n.bit, "the input bit"); }
   void Node(const ir::Stmt& s, const ir::For& n) {
-    Name(s, n.var, "the loop variable");
-    Known(StmtName(s), n.var_loc, "the loop variable");
+    Name(s, n.var, n.var_loc, "the loop variable");
     Required(s, n.from, "the start value");
     Required(s, n.to, "the end value");
     Optional(n.step);
     Block(s, n.body);
     End(s, n.end);
+    if (!n.next_var.empty()) Known(StmtName(s), n.next_var_loc, "the variable after Next");
   }
   void Node(const ir::Stmt& s, const ir::If& n) {
     if (n.branches.empty()) Issue(s, "has no branches");
@@ -230,13 +236,13 @@ class Verifier {
     }
     End(s, n.end);
   }
-  void Node(const ir::Stmt& s, const ir::Call& n) { Name(s, n.name, "the called function's name"); }
+  void Node(const ir::Stmt& s, const ir::Call& n) { Name(s, n.name, n.name_loc, "the called function's name"); }
   void Node(const ir::Stmt& s, const ir::Cycle& n) {
-    Name(s, n.fixture, "the cycled fixture's name");
+    Name(s, n.fixture, n.fixture_loc, "the cycled fixture's name");
     Block(s, n.body);
     End(s, n.end);
   }
-  void Node(const ir::Stmt& s, const ir::Scan& n) { Name(s, n.fixture, "the scanned fixture's name"); }
+  void Node(const ir::Stmt& s, const ir::Scan& n) { Name(s, n.fixture, n.fixture_loc, "the scanned fixture's name"); }
   void Node(const ir::Stmt&, const ir::ExitFunction&) {}
 };
 

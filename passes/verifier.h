@@ -13,7 +13,10 @@
 //   number and first index; only Else may lack a condition, and only last);
 // - names are non-empty (declared, referenced, called, cycled, scanned);
 // - numbers are finite: Coords and literals; an Integer literal is integral;
-// - a VarDecl has one location per name; a frame name has a location.
+// - a VarDecl has one location per name; every other name or number a
+//   check may underline has a location too (declared names, frames, pallet
+//   corners and sizes, the Vacuum output, called, cycled and scanned names,
+//   the variable after Next, the LimZ keyword).
 #pragma once
 
 #include <string>

@@ -12,7 +12,7 @@ namespace smtcal::tools {
 int PrintDiagnostics(const Diagnostics& diags, const GlobalOptions& options) {
   std::string text = options.diagnostics_format == "json" ? diags.RenderJson() : diags.RenderText();
   if (!text.empty() && (options.diagnostics_format == "json" || !diags.all().empty())) {
-    std::fputs(text.c_str(), stderr);
+    std::fwrite(text.data(), 1, text.size(), stderr);  // text may hold NUL bytes from the input
   }
   return diags.has_errors() ? kExitInputError : kExitOk;
 }

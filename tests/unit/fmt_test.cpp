@@ -22,6 +22,7 @@
 
 #include "frontend/parse.h"
 #include "passes/ir_dump.h"
+#include "tests/unit/test_support.h"
 
 namespace smtcal {
 namespace {
@@ -195,23 +196,23 @@ TEST(FmtStatements, EveryStatementWithCommentsAndBlankLines) {
   ir::Program program;
   program.items = Body(
       S(ir::Comment{" layer_a.place - three layers"}),
-      S(ir::ProgramDecl{"LayerA"}), S(ir::UnitsDecl{"mm"}),
-      S(ir::FixtureDecl{"Board"}, " geometry from the cell file"),
-      Blank(S(ir::LocalDecl{"Tray", XY(100, 50, 0, 0), "", {}})),
-      S(ir::LocalDecl{"Sub", XY(1, 2, 0, 90), "Tray", {}}),
-      S(ir::PointDecl{"Feed0805", false, XY(212.40, 35.50, -12.00, 0), "", {}}),
-      S(ir::PointDecl{"C1", false, XY(12.70, 8.25, -3.00, 90), "Board", {}}),
-      S(ir::PointDecl{"U3", true, XY(171.204, 97.311, -3.00, 0), "Board", {}}, "taught"),
-      S(ir::PalletDecl{1, {"P1", "P2", "P3"}, {}, 4, 3}), S(ir::VacuumDecl{2}),
+      S(ir::ProgramDecl{"LayerA", {}}), S(ir::UnitsDecl{"mm", {}}),
+      S(ir::FixtureDecl{"Board", {}}, " geometry from the cell file"),
+      Blank(S(ir::LocalDecl{"Tray", {}, XY(100, 50, 0, 0), "", {}})),
+      S(ir::LocalDecl{"Sub", {}, XY(1, 2, 0, 90), "Tray", {}}),
+      S(ir::PointDecl{"Feed0805", {}, false, XY(212.40, 35.50, -12.00, 0), "", {}}),
+      S(ir::PointDecl{"C1", {}, false, XY(12.70, 8.25, -3.00, 90), "Board", {}}),
+      S(ir::PointDecl{"U3", {}, true, XY(171.204, 97.311, -3.00, 0), "Board", {}}, "taught"),
+      S(ir::PalletDecl{1, {}, {"P1", "P2", "P3"}, {}, 4, {}, 3, {}}), S(ir::VacuumDecl{2, {}}),
       S(ir::VarDecl{ir::VarType::Integer, {"a", "b"}, {}}), S(ir::VarDecl{ir::VarType::Real, {"d"}, {}}));
 
   ir::Block body;
   body.push_back(S(ir::Comment{"  indented comment, spaces kept"}));
   body.push_back(S(ir::VarDecl{ir::VarType::Integer, {"layer"}, {}}));
   body.push_back(S(ir::Assign{"d", Bin(BinaryOp::Mul, Real(0.5), Var("a"))}));
-  body.push_back(S(ir::Motion{ir::MotionKind::Jump, Named("Feed0805"), Real(-5)}, " above the feeder"));
-  body.push_back(S(ir::Motion{ir::MotionKind::Go, Named("C1"), nullptr}));
-  body.push_back(S(ir::Motion{ir::MotionKind::Move, WithOffset(Named("C1"), true, ir::Axis::Y, Real(1)), nullptr}));
+  body.push_back(S(ir::Motion{ir::MotionKind::Jump, Named("Feed0805"), Real(-5), {}}, " above the feeder"));
+  body.push_back(S(ir::Motion{ir::MotionKind::Go, Named("C1"), nullptr, {}}));
+  body.push_back(S(ir::Motion{ir::MotionKind::Move, WithOffset(Named("C1"), true, ir::Axis::Y, Real(1)), nullptr, {}}));
   body.push_back(S(ir::PickPlace{ir::PickPlaceKind::Pick, Named("Feed0805"), Int(3), Real(-1)}));
   body.push_back(S(ir::PickPlace{ir::PickPlaceKind::Place, Named("U3"), nullptr, Int(0)}));
   body.push_back(Blank(S(ir::SetOutput{true, Int(5)})));
@@ -235,14 +236,14 @@ TEST(FmtStatements, EveryStatementWithCommentsAndBlankLines) {
   {
     ir::IfBranch first;
     first.condition = Bin(BinaryOp::Eq, Var("a"), Int(1));
-    first.body = Body(S(ir::Call{"Feed"}));
+    first.body = Body(S(ir::Call{"Feed", {}}));
     ir::IfBranch second;
     second.condition = Un(UnaryOp::Not, Sw(Int(3)));
     second.comment = "second";
     second.body = Body(S(ir::ExitFunction{}));
     ir::IfBranch last;
     last.comment = "otherwise";
-    last.body = Body(S(ir::Comment{"nothing"}), S(ir::Scan{"Board"}));
+    last.body = Body(S(ir::Comment{"nothing"}), S(ir::Scan{"Board", {}}));
     branch.branches.push_back(std::move(first));
     branch.branches.push_back(std::move(second));
     branch.branches.push_back(std::move(last));
@@ -339,14 +340,14 @@ TEST(FmtStatements, NextKeepsAForeignVariableForTheChecker) {
 TEST(FmtStatements, NoBlankLineAtTheTopOfTheFileAndEmptyProgramIsEmpty) {
   ir::Program program;
   EXPECT_EQ(PrintPlace(program), "");
-  program.items.push_back(Blank(S(ir::ProgramDecl{"A"})));
+  program.items.push_back(Blank(S(ir::ProgramDecl{"A", {}})));
   EXPECT_EQ(PrintPlace(program), "Program A\n");
 }
 
 TEST(FmtStatements, NoBlankLineOpensABlock) {
   ir::Function f;
   f.name = "Main";
-  f.body = Body(Blank(S(ir::Call{"A"})), Blank(S(ir::Call{"B"})));
+  f.body = Body(Blank(S(ir::Call{"A", {}})), Blank(S(ir::Call{"B", {}})));
   ir::Program program;
   program.items.push_back(S(std::move(f)));
   EXPECT_EQ(PrintPlace(program), "Function Main\n  Call A\n\n  Call B\nFend\n");
@@ -354,34 +355,20 @@ TEST(FmtStatements, NoBlankLineOpensABlock) {
 
 // ------------------------------------------------------------ round trips
 
-struct Parsed {
-  bool ok = false;
-  std::string diagnostics;
-  ir::Program program;
-};
-
-Parsed Parse(const std::string& text) {
-  SourceManager sources;
-  std::uint32_t file = sources.Add("input.place", text);
-  Diagnostics diags(sources);
-  Parsed parsed;
-  parsed.program = ParseProgram(file, diags);
-  parsed.ok = !diags.has_errors();
-  parsed.diagnostics = diags.RenderText();
-  return parsed;
-}
+using Parsed = test::ParsedText;
+Parsed Parse(const std::string& text) { return test::ParseText(text); }
 
 // The two promises of fmt for a text that parses: printing is idempotent,
 // and the printed text parses to the input's IR (up to the changes fmt makes
 // on purpose, see ApplyCanonicalChanges). Returns the printed text.
 std::string ExpectRoundTrip(const std::string& text) {
   Parsed input = Parse(text);
-  EXPECT_TRUE(input.ok) << input.diagnostics << "in:\n" << text;
-  if (!input.ok) return {};
+  EXPECT_TRUE(input.ok()) << input.diagnostics << "in:\n" << text;
+  if (!input.ok()) return {};
   std::string printed = PrintPlace(input.program);
   Parsed output = Parse(printed);
-  EXPECT_TRUE(output.ok) << output.diagnostics << "in fmt's output:\n" << printed;
-  if (!output.ok) return printed;
+  EXPECT_TRUE(output.ok()) << output.diagnostics << "in fmt's output:\n" << printed;
+  if (!output.ok()) return printed;
   ApplyCanonicalChanges(input.program);
   EXPECT_EQ(DumpIr(output.program), DumpIr(input.program)) << "input:\n" << text << "\noutput:\n" << printed;
   EXPECT_EQ(PrintPlace(output.program), printed) << "fmt is not idempotent on:\n" << text;
@@ -391,11 +378,17 @@ std::string ExpectRoundTrip(const std::string& text) {
 TEST(FmtRoundTrip, ExpressionTablesParseBackToTheSameTree) {
   for (const ExprCase& c : ExprCases()) {
     Parsed parsed = Parse("Function F\n  r = " + c.text + "\nFend\n");
-    ASSERT_TRUE(parsed.ok) << parsed.diagnostics;
+    ASSERT_TRUE(parsed.ok()) << parsed.diagnostics;
     const auto& body = std::get<ir::Function>(parsed.program.items.at(0)->node).body;
     const auto& assign = std::get<ir::Assign>(body.at(0)->node);
     EXPECT_EQ(DumpExpr(*assign.value), DumpExpr(*c.expr)) << c.text;
   }
+}
+
+TEST(FmtRoundTrip, NoLineEndsInWhitespace) {
+  std::string printed = ExpectRoundTrip(
+      "' header  \nProgram T ' name \t\nFunction Main\n  Call A '  \n  '\t\nFend ' end \n");
+  EXPECT_EQ(printed, "' header\nProgram T  ' name\nFunction Main\n  Call A\n  '\nFend  ' end\n");
 }
 
 TEST(FmtRoundTrip, EveryPlaceFileInTheRepository) {
@@ -409,7 +402,7 @@ TEST(FmtRoundTrip, EveryPlaceFileInTheRepository) {
       std::ifstream in(entry.path(), std::ios::binary);
       std::stringstream text;
       text << in.rdbuf();
-      if (!Parse(text.str()).ok) continue;  // fail_ cases with syntax errors
+      if (!Parse(text.str()).ok()) continue;  // fail_ cases with syntax errors
       SCOPED_TRACE(entry.path().string());
       ExpectRoundTrip(text.str());
       ++formatted;

@@ -77,36 +77,52 @@ class IrBuilder {
     Units("mm");
   }
   ir::Stmt& Comment(const std::string& text) { return Add("'" + text, ir::Comment{text}); }
-  ir::Stmt& Program(const std::string& name) { return Add("Program " + name, ir::ProgramDecl{name}); }
-  ir::Stmt& Units(const std::string& unit) { return Add("Units " + unit, ir::UnitsDecl{unit}); }
-  ir::Stmt& Fixture(const std::string& name) { return Add("Fixture " + name, ir::FixtureDecl{name}); }
-  ir::Stmt& Vacuum(int output) { return Add(fmt::format("Vacuum {}", output), ir::VacuumDecl{output}); }
+  // Keyword and name: the name starts after "Keyword ".
+  ir::Stmt& Program(const std::string& name) {
+    return Add("Program " + name, ir::ProgramDecl{name, Column(9)});
+  }
+  ir::Stmt& Units(const std::string& unit) { return Add("Units " + unit, ir::UnitsDecl{unit, Column(7)}); }
+  ir::Stmt& Fixture(const std::string& name) {
+    return Add("Fixture " + name, ir::FixtureDecl{name, Column(9)});
+  }
+  ir::Stmt& Vacuum(int output) {
+    return Add(fmt::format("Vacuum {}", output), ir::VacuumDecl{output, Column(8)});
+  }
 
   ir::Stmt& Local(const std::string& name, std::array<double, 4> origin, const std::string& frame = "") {
     std::string text = fmt::format("Local {} = XY({})", name, fmt::join(origin, ", "));
     SourceLoc frame_loc = FrameLoc(text, frame, " In ");
-    return Add(text, ir::LocalDecl{name, Coords(origin), frame, frame_loc});
+    return Add(text, ir::LocalDecl{name, Column(7), Coords(origin), frame, frame_loc});
   }
   ir::Stmt& Point(const std::string& name, std::array<double, 4> coords, const std::string& frame = "") {
     std::string text = fmt::format("Point {} = XY({})", name, fmt::join(coords, ", "));
     SourceLoc frame_loc = FrameLoc(text, frame, " In ");
-    return Add(text, ir::PointDecl{name, false, Coords(coords), frame, frame_loc});
+    return Add(text, ir::PointDecl{name, Column(7), false, Coords(coords), frame, frame_loc});
   }
   ir::Stmt& Taught(const std::string& name, std::array<double, 4> coords, const std::string& fixture) {
     std::string text = fmt::format("Taught Point {} = XY({})", name, fmt::join(coords, ", "));
     SourceLoc frame_loc = FrameLoc(text, fixture, " On ");
-    return Add(text, ir::PointDecl{name, true, Coords(coords), fixture, frame_loc});
+    return Add(text, ir::PointDecl{name, Column(14), true, Coords(coords), fixture, frame_loc});
   }
   ir::Stmt& PalletDecl(int number, std::array<std::string, 3> corners, int columns, int rows) {
+    ir::PalletDecl decl;
+    decl.number = number;
+    decl.number_loc = Column(8);
+    decl.corners = corners;
+    decl.columns = columns;
+    decl.rows = rows;
     std::string text = fmt::format("Pallet {}", number);
-    std::array<SourceLoc, 3> locs;
     for (int i = 0; i < 3; ++i) {
       text += ", ";
-      locs[i] = Column(text.size() + 1);
+      decl.corner_locs[i] = Column(text.size() + 1);
       text += corners[i];
     }
-    text += fmt::format(", {}, {}", columns, rows);
-    return Add(text, ir::PalletDecl{number, corners, locs, columns, rows});
+    text += ", ";
+    decl.columns_loc = Column(text.size() + 1);
+    text += fmt::format("{}, ", columns);
+    decl.rows_loc = Column(text.size() + 1);
+    text += fmt::format("{}", rows);
+    return Add(text, std::move(decl));
   }
   ir::Stmt& Variables(ir::VarType type, std::vector<std::string> names) {
     std::string text = type == ir::VarType::Integer ? "Integer" : "Real";
@@ -121,7 +137,7 @@ class IrBuilder {
 
   // Opens a Function; End() closes it with Fend.
   ir::Stmt& Function(const std::string& name) {
-    ir::Stmt& stmt = Add("Function " + name, ir::Function{name, {}, {}});
+    ir::Stmt& stmt = Add("Function " + name, ir::Function{name, Column(10), {}, {}});
     auto& function = std::get<ir::Function>(stmt.node);
     open_.push_back({&function.body, &function.end, "Fend"});
     return stmt;
@@ -134,8 +150,13 @@ class IrBuilder {
   }
   ir::Stmt& Motion(ir::MotionKind kind, ir::PointExpr target, ir::ExprPtr limz = nullptr) {
     const char* word = kind == ir::MotionKind::Jump ? "Jump" : kind == ir::MotionKind::Go ? "Go" : "Move";
-    std::string text = fmt::format("{} {}{}", word, TargetText(target), limz ? " LimZ ..." : "");
-    return Add(text, ir::Motion{kind, std::move(target), std::move(limz)});
+    std::string text = fmt::format("{} {}", word, TargetText(target));
+    SourceLoc limz_loc;
+    if (limz) {
+      limz_loc = Column(text.size() + 2);
+      text += " LimZ ...";
+    }
+    return Add(text, ir::Motion{kind, std::move(target), std::move(limz), limz_loc});
   }
   ir::Stmt& Jump(ir::PointExpr target, ir::ExprPtr limz = nullptr) {
     return Motion(ir::MotionKind::Jump, std::move(target), std::move(limz));
@@ -149,24 +170,26 @@ class IrBuilder {
   ir::Stmt& SetOutput(bool on, ir::ExprPtr bit) { return Add(on ? "On ..." : "Off ...", ir::SetOutput{on, std::move(bit)}); }
   ir::Stmt& Wait(ir::ExprPtr seconds) { return Add("Wait ...", ir::WaitTime{std::move(seconds)}); }
   ir::Stmt& WaitSw(ir::ExprPtr bit, bool on) { return Add("Wait Sw(...) = ...", ir::WaitSwitch{std::move(bit), on}); }
-  ir::Stmt& Call(const std::string& name) { return Add("Call " + name, ir::Call{name}); }
-  ir::Stmt& Scan(const std::string& fixture) { return Add("Scan " + fixture, ir::Scan{fixture}); }
+  ir::Stmt& Call(const std::string& name) { return Add("Call " + name, ir::Call{name, Column(6)}); }
+  ir::Stmt& Scan(const std::string& fixture) { return Add("Scan " + fixture, ir::Scan{fixture, Column(6)}); }
   ir::Stmt& Exit() { return Add("Exit Function", ir::ExitFunction{}); }
 
   // Opens a For; Next() closes it.
   ir::Stmt& For(const std::string& var, ir::ExprPtr from, ir::ExprPtr to, ir::ExprPtr step = nullptr) {
     SourceLoc var_loc = Column(5);
     ir::Stmt& stmt = Add(fmt::format("For {} = ... To ...", var),
-                         ir::For{var, var_loc, std::move(from), std::move(to), std::move(step), {}, {}, {}});
+                         ir::For{var, var_loc, std::move(from), std::move(to), std::move(step), {}, {}, {}, {}});
     auto& loop = std::get<ir::For>(stmt.node);
     open_.push_back({&loop.body, &loop.end, "Next"});
-    next_var_.push_back(&loop.next_var);
+    fors_.push_back(&loop);
     return stmt;
   }
   void Next(const std::string& var = "") {
-    SMTCAL_CHECK(!next_var_.empty(), "Next without For");
-    *next_var_.back() = var;
-    next_var_.pop_back();
+    SMTCAL_CHECK(!fors_.empty(), "Next without For");
+    ir::For& loop = *fors_.back();
+    fors_.pop_back();
+    loop.next_var = var;
+    if (!var.empty()) loop.next_var_loc = Column(6);  // "Next var", on the line End() adds
     End(var.empty() ? "Next" : "Next " + var);
   }
 
@@ -185,7 +208,7 @@ class IrBuilder {
 
   // Opens a Cycle; End() closes it.
   ir::Stmt& Cycle(const std::string& fixture) {
-    ir::Stmt& stmt = Add("Cycle " + fixture, ir::Cycle{fixture, {}, {}});
+    ir::Stmt& stmt = Add("Cycle " + fixture, ir::Cycle{fixture, Column(7), {}, {}});
     auto& cycle = std::get<ir::Cycle>(stmt.node);
     open_.push_back({&cycle.body, &cycle.end, "EndCycle"});
     return stmt;
@@ -288,7 +311,7 @@ class IrBuilder {
   std::uint32_t line_ = 0;
   std::vector<Open> open_;
   std::vector<ir::If*> ifs_;
-  std::vector<std::string*> next_var_;
+  std::vector<ir::For*> fors_;
 };
 
 }  // namespace smtcal::test

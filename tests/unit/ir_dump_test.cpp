@@ -46,15 +46,15 @@ ir::Program EveryNode() {
   ir::Program program;
   program.file = 1;
   program.items.push_back(Stmt(ir::Comment{" header"}));
-  program.items.push_back(Stmt(ir::ProgramDecl{"LayerA"}));
-  program.items.push_back(Stmt(ir::UnitsDecl{"mm"}));
-  program.items.push_back(Stmt(ir::FixtureDecl{"Board"}));
-  program.items.push_back(Stmt(ir::LocalDecl{"L1", ir::Coords{{1, 2, 0, 0}, {}}, "Board", {}}));
+  program.items.push_back(Stmt(ir::ProgramDecl{"LayerA", {}}));
+  program.items.push_back(Stmt(ir::UnitsDecl{"mm", {}}));
+  program.items.push_back(Stmt(ir::FixtureDecl{"Board", {}}));
+  program.items.push_back(Stmt(ir::LocalDecl{"L1", {}, ir::Coords{{1, 2, 0, 0}, {}}, "Board", {}}));
   program.items.push_back(
-      Stmt(ir::PointDecl{"U3", true, ir::Coords{{171.204, 97.311, -3, 0}, {}}, "Board", {}}));
-  program.items.push_back(Stmt(ir::PointDecl{"Feed", false, ir::Coords{{0.1, -0.0, 1e21, 90}, {}}, "", {}}));
-  program.items.push_back(Stmt(ir::PalletDecl{1, {"A", "B", "C"}, {}, 3, 4}));
-  program.items.push_back(Stmt(ir::VacuumDecl{2}));
+      Stmt(ir::PointDecl{"U3", {}, true, ir::Coords{{171.204, 97.311, -3, 0}, {}}, "Board", {}}));
+  program.items.push_back(Stmt(ir::PointDecl{"Feed", {}, false, ir::Coords{{0.1, -0.0, 1e21, 90}, {}}, "", {}}));
+  program.items.push_back(Stmt(ir::PalletDecl{1, {}, {"A", "B", "C"}, {}, 3, {}, 4, {}}));
+  program.items.push_back(Stmt(ir::VacuumDecl{2, {}}));
   program.items.push_back(Stmt(ir::VarDecl{ir::VarType::Real, {"d", "e"}, {}}));
 
   ir::Function main;
@@ -100,7 +100,7 @@ ir::Program EveryNode() {
   loop.to = Num(2, true);
   loop.step = Num(1, true);
   loop.next_var = "layer";
-  loop.body.push_back(Stmt(ir::Call{"Feed"}));
+  loop.body.push_back(Stmt(ir::Call{"Feed", {}}));
   loop.end.comment = " next";
   ir::StmtPtr for_stmt = Stmt(std::move(loop));
   for_stmt->blank_line_before = true;
@@ -117,7 +117,7 @@ ir::Program EveryNode() {
   second.comment = " second";
   branch.branches.push_back(std::move(second));
   ir::IfBranch otherwise;
-  otherwise.body.push_back(Stmt(ir::Scan{"Board"}));
+  otherwise.body.push_back(Stmt(ir::Scan{"Board", {}}));
   branch.branches.push_back(std::move(otherwise));
   main.body.push_back(Stmt(std::move(branch)));
 
@@ -171,8 +171,8 @@ TEST(IrDump, PrintsEveryNode) {
 
 TEST(IrDump, QuotesOddNamesAndEscapesComments) {
   ir::Program program;
-  program.items.push_back(Stmt(ir::ProgramDecl{"has space"}));
-  program.items.push_back(Stmt(ir::FixtureDecl{""}));
+  program.items.push_back(Stmt(ir::ProgramDecl{"has space", {}}));
+  program.items.push_back(Stmt(ir::FixtureDecl{"", {}}));
   program.items.push_back(Stmt(ir::Comment{"a \"quote\" \\ tab\t cr\r bell\x07 \xC2\xB0"}));
   EXPECT_EQ(DumpIr(program),
             "(program\n"

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "passes/ir_dump.h"
+#include "tests/unit/test_support.h"
 
 namespace smtcal {
 namespace {
@@ -22,14 +23,12 @@ struct Parsed {
 };
 
 Parsed Parse(const std::string& text) {
-  SourceManager sources;
-  std::uint32_t file = sources.Add("t.place", text);
-  Diagnostics diags(sources);
+  test::ParsedText parsed = test::ParseText(text);
   Parsed out;
-  out.program = ParseProgram(file, diags);
-  out.dump = DumpIr(out.program);
-  out.errors = diags.RenderText();
-  out.error_count = diags.error_count();
+  out.dump = DumpIr(parsed.program);
+  out.program = std::move(parsed.program);
+  out.errors = std::move(parsed.diagnostics);
+  out.error_count = parsed.error_count;
   return out;
 }
 
@@ -263,6 +262,29 @@ TEST(Parse, CommentsAndBlankLinesLandInTheirBlock) {
             "  (comment \" end\"))\n");
 }
 
+// Trailing spaces and tabs are invisible and would end a canonical line in
+// whitespace, so comments lose them; the spaces after the ' stay.
+TEST(Parse, CommentsLoseTrailingWhitespaceOnly) {
+  Parsed parsed = Parse(
+      "'  header \t \n"
+      "Program T ' name\t\n"
+      "'   \n"
+      "Function Main '\t \n"
+      "  For i = 1 To 2 ' a\tb  \r\n"
+      "  Next ' next \n"
+      "Fend\n");
+  EXPECT_EQ(parsed.errors, "");
+  EXPECT_EQ(parsed.dump,
+            "(program\n"
+            "  (comment \"  header\")\n"
+            "  (program-decl T :comment \" name\")\n"
+            "  (comment \"\")\n"
+            "  (function Main\n"
+            "    (for i (int 1) (int 2) :comment \" a\\tb\"\n"
+            "      (end :comment \" next\"))\n"
+            "    (end)))\n");
+}
+
 // ------------------------------------------------------------------ locations
 
 TEST(Parse, Locations) {
@@ -311,9 +333,50 @@ TEST(Parse, LocationsInTheDump) {
   Parsed parsed = Parse("Function Main\n  x = (1 + b)\nFend\n");
   EXPECT_EQ(DumpIr(parsed.program, true),
             "(program @1\n"
-            "  (function @1:1:1/8 Main\n"
+            "  (function @1:1:1/8 Main @1:1:10\n"
             "    (assign @1:2:3/1 x (+ @1:2:8/5 (int @1:2:8/1 1) (var @1:2:12/1 b)))\n"
             "    (end @1:3:1)))\n");
+}
+
+// Every name and number a check may underline keeps its own location, so
+// the checks never have to search the line for it.
+TEST(Parse, NameAndNumberLocations) {
+  Parsed parsed = Parse(
+      "Program T\n"
+      "Units mm\n"
+      "Fixture Board\n"
+      "Local L1 = XY(1, 2, 0, 0) In Board\n"
+      "Taught Point U3 = XY(1, 2, 3, 0) On Board\n"
+      "Pallet 12, A, B, C, 34, 5\n"
+      "Vacuum 007\n"
+      "Function Main\n"
+      "  Jump U3 LimZ -1\n"
+      "  For i = 1 To 2\n"
+      "  Next  i\n"
+      "  Call Sub\n"
+      "  Cycle Board\n"
+      "    Scan Board\n"
+      "  EndCycle\n"
+      "Fend\n");
+  EXPECT_EQ(parsed.errors, "");
+  EXPECT_EQ(DumpIr(parsed.program, true),
+            "(program @1\n"
+            "  (program-decl @1:1:1/7 T @1:1:9)\n"
+            "  (units @1:2:1/5 mm @1:2:7)\n"
+            "  (fixture @1:3:1/7 Board @1:3:9)\n"
+            "  (local @1:4:1/5 L1 @1:4:7 (xy @1:4:12 1 2 0 0) :frame @1:4:30 Board)\n"
+            "  (point-decl @1:5:1/6 U3 @1:5:14 :taught (xy @1:5:19 1 2 3 0) :frame @1:5:37 Board)\n"
+            "  (pallet-decl @1:6:1/6 12 @1:6:8 A @1:6:12 B @1:6:15 C @1:6:18 34 @1:6:21 5 @1:6:25)\n"
+            "  (vacuum-decl @1:7:1/6 7 @1:7:8)\n"
+            "  (function @1:8:1/8 Main @1:8:10\n"
+            "    (jump @1:9:3/4 (point @1:9:8 (name /2 U3)) :limz @1:9:11 (neg @1:9:16/2 (int @1:9:17/1 1)))\n"
+            "    (for @1:10:3/3 i @1:10:7 (int @1:10:11/1 1) (int @1:10:16/1 2) :next i @1:11:9\n"
+            "      (end @1:11:3))\n"
+            "    (call @1:12:3/4 Sub @1:12:8)\n"
+            "    (cycle @1:13:3/5 Board @1:13:9\n"
+            "      (scan @1:14:5/4 Board @1:14:10)\n"
+            "      (end @1:15:3))\n"
+            "    (end @1:16:1)))\n");
 }
 
 TEST(Parse, NumberFlags) {

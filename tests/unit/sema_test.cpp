@@ -57,7 +57,7 @@ TEST(SymbolTable, OneCaseInsensitiveNamespaceWhereTheFirstDefinitionWins) {
   b.End();
   b.Variables(VarType::Integer, {"count", "COUNT"});
   ir::Program& program = b.Finish();
-  sema::SymbolTable table = sema::SymbolTable::Build(program, b.sources);
+  sema::SymbolTable table = sema::SymbolTable::Build(program);
 
   const sema::Symbol* c1 = table.Find("c1");
   ASSERT_NE(c1, nullptr);
@@ -77,21 +77,10 @@ TEST(SymbolTable, DeclarationsRangeUnderlinesTheName) {
   ir::Stmt& stmt = b.Point("Feed", {0, 0, 0, 0});
   b.Variables(VarType::Real, {"a", "bee"});
   ir::Program& program = b.Finish();
-  sema::SymbolTable table = sema::SymbolTable::Build(program, b.sources);
+  sema::SymbolTable table = sema::SymbolTable::Build(program);
   EXPECT_EQ(table.Find("feed")->range.begin, (SourceLoc{IrBuilder::kFile, stmt.loc.line, 7}));
   EXPECT_EQ(table.Find("feed")->range.length, 4u);
   EXPECT_EQ(table.Find("bee")->range.begin.column, 9u);
-}
-
-TEST(SymbolTable, NameRangeMatchesWholeWordsOutsideComments) {
-  SourceManager sources;
-  std::uint32_t file = sources.Add("a.place", "  Call Placeall ' calls PlaceAll\nCall PlaceAll2\n");
-  SourceLoc start{file, 1, 3};
-  EXPECT_EQ(sema::NameRange(sources, start, "PlaceAll").begin.column, 8u);
-  // "PlaceAll" is not a whole word in "PlaceAll2", and the comment does not count.
-  SourceLoc second{file, 2, 1};
-  EXPECT_EQ(sema::NameRange(sources, second, "PlaceAll").begin, second);
-  EXPECT_EQ(sema::NameRange(sources, start, "calls").begin, start);
 }
 
 TEST(SymbolTable, FixtureOfPointsFollowsLocalChainsAndTaughtFixtures) {
@@ -109,7 +98,7 @@ TEST(SymbolTable, FixtureOfPointsFollowsLocalChainsAndTaughtFixtures) {
   b.Point("Looping", {0, 0, 0, 0}, "LoopA");
   b.Taught("U3", {0, 0, 0, 0}, "Board");
   ir::Program& program = b.Finish();
-  sema::SymbolTable table = sema::SymbolTable::Build(program, b.sources);
+  sema::SymbolTable table = sema::SymbolTable::Build(program);
   auto fixture = [&](const char* point) {
     const sema::Symbol* found = table.FixtureOfPoint(*table.Find(point));
     return found == nullptr ? std::string("-") : found->name;
@@ -132,7 +121,7 @@ TEST(SymbolTable, PalletBelongsToTheFixtureOfCornersInOneFrame) {
   b.PalletDecl(1, {"A", "B", "C"}, 2, 2);
   b.PalletDecl(2, {"A", "B", "D"}, 2, 2);  // taught on Board is another frame than In Board
   ir::Program& program = b.Finish();
-  sema::SymbolTable table = sema::SymbolTable::Build(program, b.sources);
+  sema::SymbolTable table = sema::SymbolTable::Build(program);
   ASSERT_NE(table.FixtureOfPallet(1), nullptr);
   EXPECT_EQ(table.FixtureOfPallet(1)->name, "Board");
   EXPECT_EQ(table.FixtureOfPallet(2), nullptr);
@@ -145,7 +134,7 @@ TEST(SymbolTable, LocalScopeRefusesClashesAndFallsBackToGlobals) {
   b.Variables(VarType::Real, {"speed"});
   b.Point("P1", {0, 0, 0, 0});
   ir::Program& program = b.Finish();
-  sema::SymbolTable table = sema::SymbolTable::Build(program, b.sources);
+  sema::SymbolTable table = sema::SymbolTable::Build(program);
   sema::LocalScope scope(table);
   sema::Symbol local;
   local.kind = sema::SymbolKind::Variable;

@@ -73,7 +73,7 @@ TEST(Verifier, FindsAFunctionInsideABlockAndAStatementAtTopLevel) {
   b.program.items.push_back(std::move(cycle));
   auto outer = std::make_unique<ir::Stmt>();
   outer->loc = b.program.items[4]->loc;
-  ir::Function wrapper{"Wrapper", {}, {b.program.items[4]->loc, ""}};
+  ir::Function wrapper{"Wrapper", b.program.items[4]->loc, {}, {b.program.items[4]->loc, ""}};
   wrapper.body.push_back(std::move(b.program.items[4]));
   outer->node = std::move(wrapper);
   b.program.items[4] = std::move(outer);
