@@ -10,9 +10,11 @@ cmake --build build -j"$(nproc)"
 
 example=examples/paper-cell
 echo "== smtcal check $example/layers.place"
-build/smtcal check "$example/layers.place"
-echo "== smtcal fmt $example/layers.place (canonical form)"
-build/smtcal fmt "$example/layers.place"
+build/smtcal check "$example/layers.place" && echo "no errors, no warnings"
+echo "== smtcal fmt $example/layers.place (canonical form, first 20 lines)"
+build/smtcal fmt "$example/layers.place" -o build/layers.fmt.place
+head -n 20 build/layers.fmt.place
+build/smtcal fmt --check "$example/layers.place" && echo "(the example is already in canonical form)"
 echo "== smtcal table stats $example/placing-table.csv"
 build/smtcal table stats "$example/placing-table.csv"
 echo "bootstrap: done; smtcal is build/smtcal"
