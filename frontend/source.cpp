@@ -63,18 +63,20 @@ Status WriteFileAtomically(const std::string& path, std::string_view contents) {
   std::string temp = fmt::format("{}.tmp.{}", path, ::getpid());
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) return Error{fmt::format("cannot create '{}': {}", temp, std::strerror(errno))};
+    // Name the file the user asked for; the temporary is our business.
+    if (!out) return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.flush();
     if (!out) {
       std::remove(temp.c_str());
-      return Error{fmt::format("cannot write '{}': {}", temp, std::strerror(errno))};
+      return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
     }
   }
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     int saved = errno;
     std::remove(temp.c_str());
-    return Error{fmt::format("cannot rename '{}' to '{}': {}", temp, path, std::strerror(saved))};
+    return Error{fmt::format("cannot write '{}' (renaming the finished temporary '{}' failed): {}",
+                             path, temp, std::strerror(saved))};
   }
   return Ok{};
 }

@@ -11,6 +11,7 @@
 // SMTCAL_UPDATE_GOLDEN=1 rewrites the expectations instead of comparing, so a
 // reviewer reads the change as a diff.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -63,7 +64,7 @@ std::string Trim(std::string text) {
 bool IsExpectation(const fs::path& path) {
   std::string ext = path.extension().string();
   return ext == ".out" || ext == ".err" || ext == ".args" || path.filename() == "ARGS" ||
-         path.filename().string().rfind(".tmp", 0) == 0;
+         path.filename().string().rfind('.', 0) == 0;  // hidden files, editor leftovers
 }
 
 std::vector<GoldenCase> DiscoverCases() {
@@ -114,8 +115,11 @@ TEST_P(GoldenFiles, MatchesExpectedOutput) {
   for (std::size_t at; (at = args.find("{input}")) != std::string::npos;) {
     args.replace(at, 7, ShellQuote(c.input));
   }
-  fs::path out_file = c.suite / fmt::format(".tmp.{}.out", c.input);
-  fs::path err_file = c.suite / fmt::format(".tmp.{}.err", c.input);
+  // Captured output goes to the temp directory, never into the source tree.
+  fs::path capture = fs::temp_directory_path() /
+                     fmt::format("smtcal_golden_{}_{}_{}", ::getpid(), c.suite.filename().string(), c.input);
+  fs::path out_file = capture.string() + ".out";
+  fs::path err_file = capture.string() + ".err";
   std::string command = fmt::format("cd {} && {} {} </dev/null >{} 2>{}", ShellQuote(c.suite.string()),
                                     ShellQuote(SMTCAL_BINARY), args,
                                     ShellQuote(out_file.string()), ShellQuote(err_file.string()));
