@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "frontend/check.h"
+#include "passes/tolerances.h"
 
 namespace smtcal {
 namespace {
@@ -133,15 +134,17 @@ bool SplitLine(std::string_view line, std::uint32_t file, std::uint32_t number, 
 // of them required.
 struct Schema {
   std::string_view what;  // "an error table": for messages
+  std::string_view row;   // what one data row holds: "node and axis"
   std::vector<std::string_view> columns;
   std::size_t required;
   bool header_optional;  // a headerless file has the required columns in order
 };
 
-const Schema kTableSchema{"an error table", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
+const Schema kTableSchema{
+    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
 const Schema kRawSchema{
-    "a raw measurement file", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
-const Schema kPointSchema{"a point list", {"x_mm", "y_mm"}, 2, true};
+    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
+const Schema kPointSchema{"a point list", "point", {"x_mm", "y_mm"}, 2, true};
 
 std::string JoinColumns(const Schema& schema, std::size_t count, std::string_view separator = ", ") {
   std::string text;
@@ -197,6 +200,12 @@ std::optional<Header> ReadHeader(const CsvRecord& record, const Schema& schema, 
     const CsvField& field = record.fields[f];
     std::string name = Lowercase(field.text);
     auto it = std::find(schema.columns.begin(), schema.columns.end(), name);
+    if (name.empty()) {
+      diags.Report(DiagKind::CsvEmptyColumnName, field.range);
+      ok = false;
+      header.field_names.push_back("?");
+      continue;
+    }
     if (it == schema.columns.end()) {
       std::string closest = ClosestName(field.text, known);
       suggested.push_back(closest);
@@ -262,9 +271,9 @@ class Row {
       for (std::size_t f = have; f < want; ++f) {
         missing += (missing.empty() ? "" : ", ") + std::string(header_.field_names[f]);
       }
-      diags_.Report(DiagKind::CsvFieldCount, SourceRange(record_.end), have, want, "missing: " + missing);
+      diags_.Report(DiagKind::CsvFieldCount, SourceRange(record_.end), Fields(have), want, "missing: " + missing);
     } else {
-      diags_.Report(DiagKind::CsvFieldCount, record_.fields[want].range, have, want,
+      diags_.Report(DiagKind::CsvFieldCount, record_.fields[want].range, Fields(have), want,
                     "the first extra field is shown");
     }
     return false;
@@ -290,7 +299,8 @@ class Row {
     return std::nullopt;
   }
 
-  // A finite number. `optional_column`: an empty or absent field is nullopt.
+  // A finite length in mm, within +-kMaxLengthMm. `optional_column`: an empty
+  // or absent field is nullopt.
   std::optional<double> Number(std::size_t column, bool optional_column = false) {
     const CsvField* field = Field(column);
     if (optional_column && (field == nullptr || field->text.empty())) return std::nullopt;
@@ -304,6 +314,12 @@ class Row {
     }
     if (!std::isfinite(*value)) {
       diags_.Report(DiagKind::CsvNonFinite, field->range, Printable(field->text), schema_.columns[column]);
+      ok = false;
+      return std::nullopt;
+    }
+    if (std::abs(*value) > kMaxLengthMm) {  // every number column is a length in mm
+      diags_.Report(DiagKind::CsvLengthTooLarge, field->range, Printable(field->text), schema_.columns[column],
+                    kMaxLengthMm);
       ok = false;
       return std::nullopt;
     }
@@ -338,6 +354,8 @@ class Row {
     return false;
   }
 
+  static std::string Fields(std::size_t count) { return fmt::format("{} field{}", count, count == 1 ? "" : "s"); }
+
   static std::string NumberHint(std::string_view text) {
     if (text.find(',') != std::string_view::npos) return " (write the decimal point as '.')";
     std::string lower = Lowercase(text);
@@ -366,7 +384,8 @@ std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnosti
   const std::string& name = diags.sources().File(file).name;
   if (records.empty()) {
     if (diags.error_count() == errors_before) {  // else the lines were all malformed
-      diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name));
+      diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name), schema.what,
+                   JoinColumns(schema, schema.required, ","), schema.row);
     }
     return std::nullopt;
   }
@@ -384,11 +403,31 @@ std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnosti
     return std::nullopt;
   }
   if (records.empty()) {
-    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name));
+    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name), schema.what,
+                   JoinColumns(schema, schema.required, ","), schema.row);
     return std::nullopt;
   }
   body.records = std::move(records);
   return body;
+}
+
+// Reads every data row of the file through `read_row`, which reports its
+// row's mistakes and returns nullopt to leave the row out. Reading goes on
+// after a mistake so one run reports all of them; nullopt when there was any.
+template <typename T, typename ReadRow>
+std::optional<std::vector<T>> ReadRows(std::uint32_t file, const Schema& schema, Diagnostics& diags,
+                                       ReadRow read_row) {
+  const std::size_t errors_before = diags.error_count();
+  std::optional<Body> body = ReadBody(file, schema, diags);
+  if (!body) return std::nullopt;
+  std::vector<T> rows;
+  for (const CsvRecord& record : body->records) {
+    Row row(record, body->header, schema, diags);
+    if (!row.CheckShape()) continue;
+    if (std::optional<T> value = read_row(row, record)) rows.push_back(std::move(*value));
+  }
+  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
+  return rows;
 }
 
 }  // namespace
@@ -414,22 +453,16 @@ std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
 
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags) {
   enum { kAxis, kX, kY, kError, kStddev, kCount };
-  std::size_t errors_before = diags.error_count();
-  std::optional<Body> body = ReadBody(file, kTableSchema, diags);
-  if (!body) return std::nullopt;
-  std::vector<TableNode> nodes;
-  for (const CsvRecord& record : body->records) {
-    Row row(record, body->header, kTableSchema, diags);
-    if (!row.CheckShape()) continue;
+  auto read_row = [&](Row& row, const CsvRecord&) -> std::optional<TableNode> {
     TableNode node;
     std::optional<TableAxis> axis = row.Axis(kAxis);
     std::optional<double> x = row.Number(kX), y = row.Number(kY), error = row.Number(kError);
     node.stddev_mm = row.Number(kStddev, true);
     std::optional<long long> count = row.Count(kCount, 1, true);
-    if (!row.ok) continue;
+    if (!row.ok) return std::nullopt;
     if (node.stddev_mm && *node.stddev_mm < 0) {
       diags.Report(DiagKind::TableNegativeStddev, row.Range(kStddev), row.Field(kStddev)->text);
-      continue;
+      return std::nullopt;
     }
     node.axis = *axis;
     node.x_mm = *x;
@@ -439,26 +472,21 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
     node.x_field = row.Range(kX);
     node.y_field = row.Range(kY);
     node.error_field = row.Range(kError);
-    nodes.push_back(node);
-  }
-  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
-  return AssembleErrorTable(diags.sources().File(file).name, nodes, SourceLoc{file, 0, 0}, diags);
+    return node;
+  };
+  std::optional<std::vector<TableNode>> nodes = ReadRows<TableNode>(file, kTableSchema, diags, read_row);
+  if (!nodes) return std::nullopt;
+  return AssembleErrorTable(diags.sources().File(file).name, *nodes, SourceLoc{file, 0, 0}, diags);
 }
 
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
   enum { kAxis, kX, kY, kSet, kRepetition, kError };
-  std::size_t errors_before = diags.error_count();
-  std::optional<Body> body = ReadBody(file, kRawSchema, diags);
-  if (!body) return std::nullopt;
-  std::vector<RawMeasurement> measurements;
-  for (const CsvRecord& record : body->records) {
-    Row row(record, body->header, kRawSchema, diags);
-    if (!row.CheckShape()) continue;
+  auto read_row = [](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
     std::optional<TableAxis> axis = row.Axis(kAxis);
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
     std::optional<double> error = row.Number(kError);
-    if (!row.ok) continue;
+    if (!row.ok) return std::nullopt;
     RawMeasurement m;
     m.axis = *axis;
     m.x_mm = *x;
@@ -470,30 +498,22 @@ std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t fil
     m.y_field = row.Range(kY);
     m.repetition_field = row.Range(kRepetition);
     m.error_field = row.Range(kError);
-    measurements.push_back(m);
-  }
-  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
-  return measurements;
+    return m;
+  };
+  return ReadRows<RawMeasurement>(file, kRawSchema, diags, read_row);
 }
 
 std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics& diags) {
   enum { kX, kY };
-  std::size_t errors_before = diags.error_count();
-  std::optional<Body> body = ReadBody(file, kPointSchema, diags);
-  if (!body) return std::nullopt;
-  std::vector<PointRow> points;
-  for (const CsvRecord& record : body->records) {
-    Row row(record, body->header, kPointSchema, diags);
-    if (!row.CheckShape()) continue;
+  auto read_row = [&](Row& row, const CsvRecord& record) -> std::optional<PointRow> {
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
-    if (!row.ok) continue;
+    if (!row.ok) return std::nullopt;
     SourceRange rx = row.Range(kX), ry = row.Range(kY);
     std::uint32_t begin = std::min(rx.begin.column, ry.begin.column);
     std::uint32_t end = std::max(rx.begin.column + rx.length, ry.begin.column + ry.length);
-    points.push_back({Eigen::Vector2d(*x, *y), SourceRange(SourceLoc{file, record.line, begin}, end - begin)});
-  }
-  if (diags.error_count() != errors_before || diags.limit_reached()) return std::nullopt;
-  return points;
+    return PointRow{Eigen::Vector2d(*x, *y), SourceRange(SourceLoc{file, record.line, begin}, end - begin)};
+  };
+  return ReadRows<PointRow>(file, kPointSchema, diags, read_row);
 }
 
 }  // namespace smtcal

@@ -8,7 +8,8 @@
 // ignored. The first line names the columns, in any order (the point lists may
 // leave it out: then the columns are x_mm,y_mm); a column smtcal does not know
 // is an error naming it. Numbers are read locale-independently ('.' decimal
-// point, optional exponent); nan and inf are rejected.
+// point, optional exponent); nan, inf and lengths beyond kMaxLengthMm
+// (passes/tolerances.h) are rejected.
 #pragma once
 
 #include <cstdint>

@@ -259,15 +259,15 @@ bool HasUsableShape(const ErrorTable& table) {
     if (!t.stddev_mm.empty() && t.stddev_mm.size() != t.error_mm.size()) return false;
     if (!t.count.empty() && t.count.size() != t.error_mm.size()) return false;
     if (!t.origin.empty() && t.origin.size() != t.error_mm.size()) return false;
+    // What keeps every slope, determinant and residual finite and accurate.
+    auto length = [](double v) { return std::abs(v) <= kMaxLengthMm; };  // false for NaN
     for (const std::vector<double>* lines : {&t.xs, &t.ys}) {
       for (std::size_t i = 0; i < lines->size(); ++i) {
-        if (!std::isfinite((*lines)[i])) return false;
-        if (i > 0 && !((*lines)[i] > (*lines)[i - 1])) return false;
+        if (!length((*lines)[i])) return false;
+        if (i > 0 && !((*lines)[i] - (*lines)[i - 1] >= kMinGridLineSpacingMm)) return false;
       }
     }
-    for (double v : t.error_mm) {
-      if (!std::isfinite(v)) return false;
-    }
+    if (!std::all_of(t.error_mm.begin(), t.error_mm.end(), length)) return false;
   }
   Rect domain = TableDomain(table);
   return domain.x0 < domain.x1 && domain.y0 < domain.y1;

@@ -85,9 +85,10 @@ struct Rect {
 };
 
 // True when the table can be evaluated: both axes have at least 2 x 2 nodes,
-// strictly increasing lines, finite values, consistent sizes, and the two
-// grids' rectangles overlap in a rectangle of positive area. Assembled tables
-// always can.
+// lines increasing by at least kMinGridLineSpacingMm, lines and values within
+// +-kMaxLengthMm, consistent sizes, and the two
+// grids' rectangles overlap in a rectangle of positive area. Tables assembled
+// from files always can (the readers refuse lengths beyond kMaxLengthMm).
 bool HasUsableShape(const ErrorTable& table);
 
 // Where F is defined ("inside the table"): the intersection of both grids'

@@ -32,16 +32,18 @@ void CheckSolvable(const TableAnalysis& analysis) {
                "an inverse solver needs a table that passed ValidateErrorTable");
 }
 
-// Applies the outside policy to a solved (or directly calibrated) point.
+// Applies the outside policy to a solved (or directly calibrated) point,
+// whether or not the solver converged: a point outside is never corrected
+// unless the policy says so.
 Solution ApplyPolicy(const CalibrationMap& map, Solution solution, const Eigen::Vector2d& nominal,
                      const Eigen::Vector2d& input, OutsidePolicy policy) {
-  if (solution.status == SolveStatus::kNotConverged || map.Inside(nominal)) return solution;
+  if (map.Inside(nominal)) return solution;
   switch (policy) {
     case OutsidePolicy::kError:
       solution.status = SolveStatus::kOutside;
       break;
     case OutsidePolicy::kClamp:
-      solution.status = SolveStatus::kClamped;
+      if (solution.status != SolveStatus::kNotConverged) solution.status = SolveStatus::kClamped;
       break;
     case OutsidePolicy::kNone:
       solution = Solution{input, 0, 0, SolveStatus::kUncorrected};
@@ -83,6 +85,11 @@ InverseSolver::InverseSolver(const ErrorTable& table, const TableAnalysis& analy
   CheckSolvable(analysis);
   iteration_bound_ = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
 }
+
+// Every kept step has |r'|_inf <= L |r|_inf, hence |r'|_2 <= sqrt(2) L |r|_2:
+// with sqrt(2) L < 1 the Euclidean residual shrinks too, which the solver's
+// early stop relies on (docs/error-tables.md).
+static_assert(kMaxErrorSlope * 1.4142135623730951 < 1, "the solver's early stop needs L < 1/sqrt(2)");
 
 Solution InverseSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const {
   SMTCAL_CHECK(std::isfinite(actual.x()) && std::isfinite(actual.y()), "solving for a non-finite point");
@@ -126,8 +133,10 @@ Solution InverseSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy polic
       map_.DeltaAndJacobian(n, delta, jacobian);
       residual = n + delta - actual;
     }
+    // In exact arithmetic |r|_2 shrinks at every step (see the static_assert
+    // above), so a step that does not shrink it is rounding.
     const double new_norm = residual.norm();
-    if (!(new_norm < norm)) {  // rounding, not the table, limits it now: keep the better point
+    if (!(new_norm < norm)) {  // keep the better point
       n = previous_n, delta = previous_delta, residual = previous_residual, jacobian = previous_jacobian;
       break;
     }
@@ -175,66 +184,49 @@ PaperSolver::PaperSolver(const ErrorTable& table, double tolerance_mm, int max_s
   CheckSolvable(AnalyzeTable(table));
   SMTCAL_CHECK(tolerance_mm > 0 && max_steps >= 2, "the paper's solver needs a tolerance and 2 steps");
   const Rect& d = map_.domain();
-  row_xs_ = LinesWithin(map_.xs(TableAxis::X), d.x0, d.x1);
-  row_ys_ = LinesWithin(map_.ys(TableAxis::X), d.y0, d.y1);
-  column_ys_ = LinesWithin(map_.ys(TableAxis::Y), d.y0, d.y1);
-  column_xs_ = LinesWithin(map_.xs(TableAxis::Y), d.x0, d.x1);
+  x_function_ = {TableAxis::X, LinesWithin(map_.xs(TableAxis::X), d.x0, d.x1),
+                 LinesWithin(map_.ys(TableAxis::X), d.y0, d.y1)};
+  y_function_ = {TableAxis::Y, LinesWithin(map_.ys(TableAxis::Y), d.y0, d.y1),
+                 LinesWithin(map_.xs(TableAxis::Y), d.x0, d.x1)};
 }
 
-// The discrete function x_N(x_N + Delta-x, y_N) on the row at nominal y: the
-// row's nodes map nominal x_i to actual x_i + Delta-x(x_i, y) (between grid
-// rows Delta-x is interpolated linearly along each column), and the actual x
-// is inverted by linear interpolation between neighbouring nodes. Rows are
-// taken where F is defined (the domain; outside it, its edge row), so the
-// paper's functions and the direct calibration agree everywhere.
-double PaperSolver::NominalXOnRow(double actual_x, double y) const {
-  y = std::clamp(y, row_ys_.front(), row_ys_.back());
-  return InvertPiecewiseLinear(row_xs_, [&](double x) { return map_.AxisDelta(TableAxis::X, x, y); }, actual_x);
-}
-
-// y_N(x_N, y_N + Delta-y) on the column at nominal x, as above.
-double PaperSolver::NominalYOnColumn(double actual_y, double x) const {
-  x = std::clamp(x, column_xs_.front(), column_xs_.back());
-  return InvertPiecewiseLinear(column_ys_, [&](double y) { return map_.AxisDelta(TableAxis::Y, x, y); }, actual_y);
-}
-
-// The interval of nominal x that gives the actual x on the rows within the
-// nominal y interval: the rows at both ends and every grid row inside.
-PaperSolver::Interval PaperSolver::StepX(double actual_x, Interval y) const {
-  double first = NominalXOnRow(actual_x, y.lo);
-  Interval x{first, first};
-  auto include = [&](double row_y) {
-    double v = NominalXOnRow(actual_x, row_y);
-    x.lo = std::min(x.lo, v);
-    x.hi = std::max(x.hi, v);
+// On the row (column) at nominal `across`, the nodes map nominal v to actual
+// v + Delta(v) (between grid rows Delta is interpolated linearly along each
+// column), and the actual value is inverted by linear interpolation between
+// neighbouring nodes. Rows are taken where F is defined (the domain; outside
+// it, its edge row), so the paper's functions and the direct calibration
+// agree everywhere.
+double PaperSolver::Nominal(const DiscreteFunction& f, double actual, double across) const {
+  across = std::clamp(across, f.across.front(), f.across.back());
+  auto delta = [&](double along) {
+    return f.axis == TableAxis::X ? map_.AxisDelta(TableAxis::X, along, across)
+                                  : map_.AxisDelta(TableAxis::Y, across, along);
   };
-  include(y.hi);
-  for (double row_y : row_ys_) {
-    if (row_y > y.lo && row_y < y.hi) include(row_y);
-  }
-  return x;
+  return InvertPiecewiseLinear(f.along, delta, actual);
 }
 
-PaperSolver::Interval PaperSolver::StepY(double actual_y, Interval x) const {
-  double first = NominalYOnColumn(actual_y, x.lo);
-  Interval y{first, first};
-  auto include = [&](double column_x) {
-    double v = NominalYOnColumn(actual_y, column_x);
-    y.lo = std::min(y.lo, v);
-    y.hi = std::max(y.hi, v);
+// The rows (columns) within the interval: those at both ends and every grid
+// row (column) inside.
+PaperSolver::Interval PaperSolver::Step(const DiscreteFunction& f, double actual, Interval across) const {
+  double first = Nominal(f, actual, across.lo);
+  Interval found{first, first};
+  auto include = [&](double line) {
+    double v = Nominal(f, actual, line);
+    found.lo = std::min(found.lo, v);
+    found.hi = std::max(found.hi, v);
   };
-  include(x.hi);
-  for (double column_x : column_xs_) {
-    if (column_x > x.lo && column_x < x.hi) include(column_x);
+  include(across.hi);
+  for (double line : f.across) {
+    if (line > across.lo && line < across.hi) include(line);
   }
-  return y;
+  return found;
 }
 
 Solution PaperSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const {
   SMTCAL_CHECK(std::isfinite(actual.x()) && std::isfinite(actual.y()), "solving for a non-finite point");
   // Step 1: all nominal rows. Step 2: y within the x interval found.
-  Interval x = StepX(actual.x(), Interval{row_ys_.front(), row_ys_.back()});
-  Interval y = StepY(actual.y(), x);
+  Interval x = Step(x_function_, actual.x(), Interval{x_function_.across.front(), x_function_.across.back()});
+  Interval y = Step(y_function_, actual.y(), x);
   int steps = 2;
   Eigen::Vector2d n;
   double residual = 0;
@@ -246,9 +238,9 @@ Solution PaperSolver::Solve(const Eigen::Vector2d& actual, OutsidePolicy policy)
     if (residual <= tolerance_mm_ || steps >= max_steps_) break;
     ++steps;
     if (steps % 2 == 1) {
-      x = StepX(actual.x(), y);
+      x = Step(x_function_, actual.x(), y);
     } else {
-      y = StepY(actual.y(), x);
+      y = Step(y_function_, actual.y(), x);
     }
   }
   Solution solution{n, residual, steps, SolveStatus::kOk};

@@ -94,7 +94,8 @@ class PaperSolver {
                        int max_steps = kPaperSolverMaxSteps);
 
   // Iterations = interval steps taken. kNotConverged when max_steps ran out
-  // before the corrected interval means came within the tolerance.
+  // before the corrected interval means came within the tolerance (outside
+  // the table only under kClamp: kError and kNone apply as usual).
   Solution Solve(const Eigen::Vector2d& actual, OutsidePolicy policy) const;
 
   double tolerance_mm() const { return tolerance_mm_; }
@@ -104,22 +105,28 @@ class PaperSolver {
   struct Interval {
     double lo, hi;
   };
-  // Nominal x giving actual x on the x table's row at nominal y.
-  double NominalXOnRow(double actual_x, double y) const;
-  // Nominal y giving actual y on the y table's column at nominal x.
-  double NominalYOnColumn(double actual_y, double x) const;
-  Interval StepX(double actual_x, Interval y) const;
-  Interval StepY(double actual_y, Interval x) const;
+  // One of the paper's two discrete functions, the same construction with x
+  // and y swapped: x_N(x_N + Delta-x, y_N) on the rows of the x table (along
+  // = x, across = y) and y_N(x_N, y_N + Delta-y) on the columns of the y
+  // table (along = y, across = x). Its nodes lie within the domain (where F
+  // is defined): the domain's edges and the grid lines between them.
+  struct DiscreteFunction {
+    TableAxis axis;
+    std::vector<double> along;   // the nodes of each row (column)
+    std::vector<double> across;  // the rows (columns): nominal y (x)
+  };
+  // The nominal coordinate along f's axis that gives `actual` on the row
+  // (column) at nominal `across`.
+  double Nominal(const DiscreteFunction& f, double actual, double across) const;
+  // The interval of that nominal coordinate over the rows (columns) within
+  // the interval `across`.
+  Interval Step(const DiscreteFunction& f, double actual, Interval across) const;
 
   CalibrationMap map_;
   double tolerance_mm_;
   int max_steps_;
-  // The nodes of the discrete functions, within the domain (where F is
-  // defined): the domain's edges and the grid lines between them.
-  std::vector<double> row_xs_;  // x nodes of the x table's rows
-  std::vector<double> row_ys_;  // the x table's rows (nominal y)
-  std::vector<double> column_ys_;  // y nodes of the y table's columns
-  std::vector<double> column_xs_;  // the y table's columns (nominal x)
+  DiscreteFunction x_function_;  // x_N(x_N + Delta-x, y_N)
+  DiscreteFunction y_function_;  // y_N(x_N, y_N + Delta-y)
 };
 
 }  // namespace smtcal

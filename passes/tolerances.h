@@ -34,11 +34,19 @@ inline constexpr double kMinJacobianDet = 0.5;
 // L = max |grad(Delta)|_inf stays at or below this. L < 1 is what makes the
 // fixed-point step of the inverse solver contract (and the iteration bound
 // finite); 0.5 keeps that bound small and is still 100x a real robot's slope.
+// The solver's early stop also needs it below 1/sqrt(2) (static_assert there).
 inline constexpr double kMaxErrorSlope = 0.5;
 
 // Grid lines of one axis table closer than this are the same line written two
 // ways (a rounding difference between measurement sessions), not a grid.
 inline constexpr double kMinGridLineSpacingMm = 0.01;
+
+// The largest |length| a table, raw or point file may hold (coordinates,
+// errors, stddevs): 100 m, far beyond any robot cell, so a larger value is a
+// unit mistake. Within it double arithmetic keeps the inverse residual far
+// below kInverseResidualTolMm (an ulp of 2e5 mm is 3e-11 mm) and the fold
+// check's slopes finite (at most 2e5 mm over kMinGridLineSpacingMm).
+inline constexpr double kMaxLengthMm = 1e5;
 
 // A point this close outside the table's rectangle still counts as inside, so
 // a solution that lands on the edge up to rounding is not called "outside".

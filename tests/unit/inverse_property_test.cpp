@@ -293,6 +293,25 @@ TEST(InverseProperty, OutsidePolicies) {
   EXPECT_EQ(clamped.point, outside + solver.map().Delta(corner));
 }
 
+// The outside policy holds even when the paper's solver runs out of steps:
+// a point outside is refused or left unchanged, never corrected silently.
+TEST(InverseProperty, OutsidePoliciesHoldWhenThePaperSolverDoesNotConverge) {
+  std::mt19937_64 rng(BaseSeed() + 5500);
+  SCOPED_TRACE(fmt::format("seed {}", BaseSeed() + 5500));
+  ErrorTable table = RandomTable(rng, 0.05);
+  PaperSolver paper(table, 1e-300, 2);  // two steps never reach 1e-300 mm
+  const Rect d = paper.map().domain();
+  const Eigen::Vector2d outside(0.5 * (d.x0 + d.x1), d.y1 + 10);
+  EXPECT_EQ(paper.Solve(outside, OutsidePolicy::kError).status, SolveStatus::kOutside);
+  Solution none = paper.Solve(outside, OutsidePolicy::kNone);
+  EXPECT_EQ(none.status, SolveStatus::kUncorrected);
+  EXPECT_EQ(none.point, outside);
+  EXPECT_EQ(paper.Solve(outside, OutsidePolicy::kClamp).status, SolveStatus::kNotConverged);
+  const Eigen::Vector2d inside(0.5 * (d.x0 + d.x1), 0.5 * (d.y0 + d.y1));
+  EXPECT_EQ(paper.Solve(inside + paper.map().Delta(inside), OutsidePolicy::kError).status,
+            SolveStatus::kNotConverged);
+}
+
 TEST(InverseProperty, PaperSolverStopsWithinItsTolerance) {
   int most_steps = 0;
   for (double tolerance : {kPaperSolverTolMm, 1e-6}) {

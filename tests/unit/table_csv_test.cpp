@@ -135,6 +135,37 @@ TEST(TableCsv, RejectsWhatIsNotANumber) {
   }
 }
 
+// Lengths far beyond a robot cell (|v| > kMaxLengthMm) are refused where they
+// are read: in double arithmetic they would break the fold check (an inf - inf
+// slope is NaN, and a NaN determinant passed it) and the inverse solver's
+// 1e-9 mm guarantee (a constant 1e308 error left a residual of 2.5 mm).
+TEST(TableCsv, RejectsLengthsFarBeyondARobotCell) {
+  const char* tables[] = {
+      // a fold of +-1e308 at the nodes
+      "axis,x_mm,y_mm,error_mm\nx,0,0,1e308\nx,5,0,-1e308\nx,0,5,-1e308\nx,5,5,1e308\n"
+      "y,0,0,0\ny,5,0,0\ny,0,5,0\ny,5,5,0\n",
+      // a constant error of 1e308 mm
+      "axis,x_mm,y_mm,error_mm\nx,0,0,1e308\nx,5,0,1e308\nx,0,5,1e308\nx,5,5,1e308\n"
+      "y,0,0,0\ny,5,0,0\ny,0,5,0\ny,5,5,0\n",
+      // grid lines at +-1e308 mm
+      "axis,x_mm,y_mm,error_mm\nx,-1e308,0,0\nx,1e308,0,0\nx,-1e308,5,0\nx,1e308,5,0\n"
+      "y,-1e308,0,0\ny,1e308,0,0\ny,-1e308,5,0\ny,1e308,5,0\n"};
+  for (const char* text : tables) {
+    SCOPED_TRACE(text);
+    Read r(text);
+    std::optional<ErrorTable> table = ReadErrorTable(r.file, r.diags);
+    EXPECT_FALSE(table && ValidateErrorTable(*table, r.diags, TableWarnings::kSkip));
+    ASSERT_FALSE(r.diags.all().empty());
+    EXPECT_EQ(r.diags.all()[0].kind, DiagKind::CsvLengthTooLarge);
+  }
+  Read points("1e300,5\n");
+  EXPECT_FALSE(ReadPoints(points.file, points.diags).has_value());
+  Read raw("axis,x_mm,y_mm,set,repetition,error_mm\nx,0,0,1,1,-2e5\n");
+  EXPECT_FALSE(ReadRawMeasurements(raw.file, raw.diags).has_value());
+  Read fine(fmt::format("{},-{}\n", kMaxLengthMm, kMaxLengthMm));
+  EXPECT_TRUE(ReadPoints(fine.file, fine.diags).has_value()) << fine.diags.RenderText();
+}
+
 TEST(TableCsv, RawMeasurements) {
   Read r("axis,x_mm,y_mm,set,repetition,error_mm\n"
          "x,0,0,1,1,-0.050\n"
