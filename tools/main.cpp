@@ -11,7 +11,7 @@ namespace smtcal::tools {
 
 int PrintDiagnostics(const Diagnostics& diags, const GlobalOptions& options) {
   std::string text = options.diagnostics_format == "json" ? diags.RenderJson() : diags.RenderText();
-  if (!text.empty() && (options.diagnostics_format == "json" || !diags.all().empty())) {
+  if (!text.empty()) {  // JSON always prints its array, even an empty one
     std::fwrite(text.data(), 1, text.size(), stderr);  // text may hold NUL bytes from the input
   }
   return diags.has_errors() ? kExitInputError : kExitOk;

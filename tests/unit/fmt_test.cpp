@@ -2,7 +2,6 @@
 // statements and comments), then round trips through the parser.
 #include "backend/place_printer.h"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -670,11 +669,7 @@ TEST(FmtDocs, LanguageReferenceExamplesParseAndAreCanonical) {
 // A scratch folder per test, and the real executable run in it.
 class FmtCommand : public testing::Test {
  protected:
-  struct Run {
-    int exit_code = -1;
-    std::string out;
-    std::string err;
-  };
+  using Run = test::SmtcalRun;
 
   void SetUp() override {
     dir_ = std::filesystem::temp_directory_path() /
@@ -688,24 +683,10 @@ class FmtCommand : public testing::Test {
   void Write(const std::string& name, const std::string& text) const {
     std::ofstream(dir_ / name, std::ios::binary) << text;
   }
-  std::string Read(const std::string& name) const {
-    std::ifstream in(dir_ / name, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
+  std::string Read(const std::string& name) const { return test::ReadFileText(dir_ / name); }
   // `args` run in the scratch folder; stdin from the file `input` if given.
   Run Smtcal(const std::string& args, const std::string& input = "") const {
-    std::string command = fmt::format("cd '{}' && '{}' {} <{} >.stdout 2>.stderr", dir_.string(), SMTCAL_BINARY, args,
-                                      input.empty() ? "/dev/null" : input);
-    int status = std::system(command.c_str());
-    Run run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Read(".stdout");
-    run.err = Read(".stderr");
-    std::filesystem::remove(dir_ / ".stdout");
-    std::filesystem::remove(dir_ / ".stderr");
-    return run;
+    return test::RunSmtcal(args, dir_, input.empty() ? "" : Read(input));
   }
 
   static constexpr const char* kMessy = "program A\nfunction   MAIN\njump p1   limz -5.00\nfend";

@@ -10,9 +10,6 @@
 //
 // SMTCAL_UPDATE_GOLDEN=1 rewrites the expectations instead of comparing, so a
 // reviewer reads the change as a diff.
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -26,6 +23,8 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include "tests/unit/test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -38,13 +37,7 @@ struct GoldenCase {
 // Failure messages name the case, not its bytes.
 void PrintTo(const GoldenCase& c, std::ostream* os) { *os << (c.suite / c.input).string(); }
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using smtcal::test::ReadFileText;
 
 void WriteOrRemove(const fs::path& path, const std::string& text) {
   if (text.empty()) {
@@ -111,41 +104,28 @@ TEST_P(GoldenFiles, MatchesExpectedOutput) {
   fs::path stem = c.suite / fs::path(c.input).stem();
   fs::path args_file = fs::exists(stem.string() + ".args") ? fs::path(stem.string() + ".args")
                                                             : c.suite / "ARGS";
-  std::string args = Trim(ReadFile(args_file));
+  std::string args = Trim(ReadFileText(args_file));
   for (std::size_t at; (at = args.find("{input}")) != std::string::npos;) {
     args.replace(at, 7, ShellQuote(c.input));
   }
-  // Captured output goes to the temp directory, never into the source tree.
-  fs::path capture = fs::temp_directory_path() /
-                     fmt::format("smtcal_golden_{}_{}_{}", ::getpid(), c.suite.filename().string(), c.input);
-  fs::path out_file = capture.string() + ".out";
-  fs::path err_file = capture.string() + ".err";
-  std::string command = fmt::format("cd {} && {} {} </dev/null >{} 2>{}", ShellQuote(c.suite.string()),
-                                    ShellQuote(SMTCAL_BINARY), args,
-                                    ShellQuote(out_file.string()), ShellQuote(err_file.string()));
-  int status = std::system(command.c_str());
-  ASSERT_TRUE(WIFEXITED(status)) << command;
-  int exit_code = WEXITSTATUS(status);
-  std::string out = ReadFile(out_file);
-  std::string err = ReadFile(err_file);
-  fs::remove(out_file);
-  fs::remove(err_file);
+  smtcal::test::SmtcalRun run = smtcal::test::RunSmtcal(args, c.suite);
+  ASSERT_NE(run.exit_code, -1) << run.command;
 
   bool must_fail = c.input.rfind("fail_", 0) == 0;
-  EXPECT_EQ(exit_code, must_fail ? 1 : 0) << "command: " << command << "\nstderr:\n" << err;
+  EXPECT_EQ(run.exit_code, must_fail ? 1 : 0) << "command: " << run.command << "\nstderr:\n" << run.err;
 
   fs::path expected_out = stem.string() + ".out";
   fs::path expected_err = stem.string() + ".err";
   const char* update = std::getenv("SMTCAL_UPDATE_GOLDEN");
   if (update != nullptr && std::string(update) == "1") {
-    WriteOrRemove(expected_out, out);
-    WriteOrRemove(expected_err, err);
+    WriteOrRemove(expected_out, run.out);
+    WriteOrRemove(expected_err, run.err);
     return;
   }
-  EXPECT_EQ(out, ReadFile(expected_out)) << "stdout of: " << command;
-  EXPECT_EQ(err, ReadFile(expected_err)) << "stderr of: " << command;
+  EXPECT_EQ(run.out, ReadFileText(expected_out)) << "stdout of: " << run.command;
+  EXPECT_EQ(run.err, ReadFileText(expected_err)) << "stderr of: " << run.command;
   if (must_fail) {
-    EXPECT_NE(err.find("error"), std::string::npos) << "a fail_ case must report an error";
+    EXPECT_NE(run.err.find("error"), std::string::npos) << "a fail_ case must report an error";
   }
 }
 

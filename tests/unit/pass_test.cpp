@@ -1,6 +1,5 @@
 // The pass registry and runner: names, descriptions, selection by name, and
 // the verify-after-each switch that names the pass that broke the IR.
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -16,6 +15,7 @@
 
 #include "passes/pass_manager.h"
 #include "tests/unit/ir_builder.h"
+#include "tests/unit/test_support.h"
 
 namespace smtcal {
 namespace {
@@ -119,26 +119,15 @@ TEST(RunPasses, WithoutVerifyEachABrokenIrIsNotLookedAt) {
 
 // ---------------------------------------------------------------- smtcal check
 
-struct CheckRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using CheckRun = test::SmtcalRun;
 
+// `smtcal check ARGS p.place` on `program_text`, in a scratch folder.
 CheckRun RunCheck(const std::string& args, const std::string& program_text) {
   namespace fs = std::filesystem;
   fs::path dir = fs::temp_directory_path() / fmt::format("smtcal_pass_test_{}", ::getpid());
   fs::create_directories(dir);
   std::ofstream(dir / "p.place") << program_text;
-  std::string command = fmt::format("cd {} && {} check {} p.place >out 2>err", dir.string(), SMTCAL_BINARY, args);
-  int status = std::system(command.c_str());
-  auto slurp = [&](const char* name) {
-    std::ifstream in(dir / name);
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    return buffer.str();
-  };
-  CheckRun run{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp("out"), slurp("err")};
+  CheckRun run = test::RunSmtcal(fmt::format("check {} p.place", args), dir);
   fs::remove_all(dir);
   return run;
 }

@@ -1,12 +1,9 @@
 // `smtcal table ...` as a user runs it: help on every subcommand, points from
 // stdin, exit codes, and files written whole. (The outputs themselves are in
 // the golden suites tests/golden/tables-*.)
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -14,23 +11,16 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/test_support.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
 const std::string kTable = std::string(SMTCAL_SOURCE_DIR) + "/examples/paper-cell/placing-table.csv";
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using CliRun = smtcal::test::SmtcalRun;
+using smtcal::test::ReadFileText;
 
 fs::path TempDir() {
   fs::path dir = fs::temp_directory_path() / fmt::format("smtcal_table_cli_{}", ::getpid());
@@ -40,16 +30,7 @@ fs::path TempDir() {
 
 // Runs `smtcal args` with `input` on stdin.
 CliRun Smtcal(const std::string& args, const std::string& input = "") {
-  fs::path dir = TempDir();
-  std::ofstream(dir / "in", std::ios::binary) << input;
-  std::string command = fmt::format("{} {} <{} >{} 2>{}", SMTCAL_BINARY, args, (dir / "in").string(),
-                                    (dir / "out").string(), (dir / "err").string());
-  int status = std::system(command.c_str());
-  CliRun run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = Slurp(dir / "out");
-  run.err = Slurp(dir / "err");
-  return run;
+  return smtcal::test::RunSmtcal(args, fs::temp_directory_path(), input);
 }
 
 class TableCli : public testing::Test {
@@ -118,10 +99,10 @@ TEST_F(TableCli, BuildAndPlotWriteTheirFiles) {
   CliRun build = Smtcal(fmt::format("table build {}/examples/paper-cell/placing-raw.csv -o {}", SMTCAL_SOURCE_DIR,
                                  table.string()));
   ASSERT_EQ(build.exit_code, 0) << build.err;
-  EXPECT_EQ(Slurp(table), Slurp(kTable));
+  EXPECT_EQ(ReadFileText(table), ReadFileText(kTable));
   CliRun draw = Smtcal(fmt::format("table plot {} -o {}", table.string(), plot.string()));
   ASSERT_EQ(draw.exit_code, 0) << draw.err;
-  std::string svg = Slurp(plot);
+  std::string svg = ReadFileText(plot);
   EXPECT_EQ(svg.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0), 0u);
   EXPECT_NE(svg.find("</svg>\n"), std::string::npos);
   for (const auto& entry : fs::directory_iterator(dir)) {

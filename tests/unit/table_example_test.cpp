@@ -14,25 +14,21 @@
 #include "passes/error_table_build.h"
 #include "passes/error_table_check.h"
 #include "passes/inverse_calibration.h"
+#include "tests/unit/test_support.h"
 
 namespace smtcal {
 namespace {
 
 const std::filesystem::path kDir = std::filesystem::path(SMTCAL_SOURCE_DIR) / "examples" / "paper-cell";
 
-std::string Slurp(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using test::ReadFileText;
 
 struct Example {
   SourceManager sources;
   Diagnostics diags{sources};
   std::optional<ErrorTable> table;
   Example() {
-    std::uint32_t file = sources.Add("placing-table.csv", Slurp(kDir / "placing-table.csv"));
+    std::uint32_t file = sources.Add("placing-table.csv", ReadFileText(kDir / "placing-table.csv"));
     table = ReadErrorTable(file, diags);
   }
 };
@@ -42,14 +38,14 @@ long Um(double mm) { return std::lround(mm * 1000); }
 TEST(PaperCellExample, TheTableIsTheBuildOfTheRawMeasurements) {
   SourceManager sources;
   Diagnostics diags(sources);
-  std::uint32_t file = sources.Add("placing-raw.csv", Slurp(kDir / "placing-raw.csv"));
+  std::uint32_t file = sources.Add("placing-raw.csv", ReadFileText(kDir / "placing-raw.csv"));
   std::optional<std::vector<RawMeasurement>> raw = ReadRawMeasurements(file, diags);
   ASSERT_TRUE(raw.has_value()) << diags.RenderText();
   EXPECT_EQ(raw->size(), 2u * 121 * 2 * 10);
   std::optional<ErrorTable> table = BuildErrorTable("placing-table.csv", *raw, SourceLoc{file, 0, 0}, diags);
   ASSERT_TRUE(table.has_value()) << diags.RenderText();
   EXPECT_TRUE(diags.all().empty()) << "the shipped data are clean:\n" << diags.RenderText();
-  EXPECT_EQ(FormatTableCsv(*table, BuiltTableComment("placing-raw.csv")), Slurp(kDir / "placing-table.csv"))
+  EXPECT_EQ(FormatTableCsv(*table, BuiltTableComment("placing-raw.csv")), ReadFileText(kDir / "placing-table.csv"))
       << "regenerate: build/smtcal_gen_paper_tables examples/paper-cell";
 }
 
@@ -117,7 +113,7 @@ TEST(PaperCellExample, ThePlotIsCurrent) {
   Example e;
   ASSERT_TRUE(e.table.has_value()) << e.diags.RenderText();
   // (Not EXPECT_EQ: a 400 kB diff helps nobody.)
-  EXPECT_TRUE(PlotTableSvg(*e.table, "placing-table.csv") == Slurp(kDir / "placing-table.svg"))
+  EXPECT_TRUE(PlotTableSvg(*e.table, "placing-table.csv") == ReadFileText(kDir / "placing-table.svg"))
       << "placing-table.svg is stale; regenerate: build/smtcal_gen_paper_tables examples/paper-cell";
 }
 
