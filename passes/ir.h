@@ -16,6 +16,10 @@
 
 #include "frontend/source.h"
 
+namespace smtcal {
+struct CompileState;  // passes/compile_state.h
+}
+
 namespace smtcal::ir {
 
 // ------------------------------------------------------------------ expressions
@@ -242,6 +246,9 @@ struct Stmt {
 struct Program {
   std::uint32_t file = 0;  // SourceManager id of the main source
   Block items;             // top level, in source order
+  // Set by the bind pass when the program is compiled for a cell; what the
+  // correction passes found (passes/compile_state.h). Null for `check`.
+  std::shared_ptr<CompileState> compile;
 };
 
 }  // namespace smtcal::ir

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "passes/checks.h"
+#include "passes/correction_passes.h"
 #include "passes/pass.h"
 #include "passes/pass_manager.h"
 #include "passes/verifier.h"
@@ -28,6 +29,23 @@ const std::vector<PassInfo>& PassRegistry() {
        CreateCheckFixtureScopePass},
       {"check-reachability", "unreachable statements, functions never called, recursion",
        CreateCheckReachabilityPass},
+  };
+  return registry;
+}
+
+const std::vector<PassInfo>& CorrectionPassRegistry() {
+  static const std::vector<PassInfo> registry = {
+      {"bind", "program fixtures bound to the cell's; FIX_0 of taught points; every motion target found",
+       CreateBindPass},
+      {"regions", "each target's calibrated region and correction kind; regions must calibrate x and y",
+       CreateRegionsPass},
+      {"static-inversion", "base-frame targets get nominal coordinates through the inverse calibration",
+       CreateStaticInversionPass},
+      {"fixture-correction", "taught points to FIXPOS_0 = FIX_0^-1 F(ROBOT_0); what the runtime needs per target",
+       CreateFixtureCorrectionPass},
+      {"scan-injection", "every Cycle opens with the Scan of its fixture", CreateScanInjectionPass},
+      {"verify", "robot limits, regions under every allowed fixture pose, residuals, tolerance budgets, cycle time",
+       CreateVerifyTargetsPass},
   };
   return registry;
 }
@@ -91,11 +109,13 @@ void RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<const
   }
 }
 
-std::string DescribePasses() {
+std::string DescribePasses() { return DescribePasses(PassRegistry()); }
+
+std::string DescribePasses(const std::vector<PassInfo>& registry) {
   std::size_t width = 0;
-  for (const PassInfo& info : PassRegistry()) width = std::max(width, info.name.size());
+  for (const PassInfo& info : registry) width = std::max(width, info.name.size());
   std::string text;
-  for (const PassInfo& info : PassRegistry()) {
+  for (const PassInfo& info : registry) {
     text += fmt::format("  {:<{}}  {}\n", info.name, width, info.description);
   }
   return text;

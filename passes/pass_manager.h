@@ -32,5 +32,7 @@ void RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<const
 
 // One line per registered pass, "  name  description", for --help.
 std::string DescribePasses();
+// The same for another registry (CorrectionPassRegistry()).
+std::string DescribePasses(const std::vector<PassInfo>& registry);
 
 }  // namespace smtcal

@@ -69,4 +69,49 @@ inline constexpr double kNoisyNodeFloorMm = 0.001;
 inline constexpr double kSetShiftFactor = 6.0;
 inline constexpr double kSetShiftFloorMm = 0.001;
 
+// --- the cell file -------------------------------------------------------------
+// (frontend/cell_toml.cpp; docs/cell.md)
+
+// The marker edge lines of a fixture must cross at S1 = (0,0), S2 = (L1,0) and
+// S3 = (0,L2) within this. Edges and L1/L2 come from one drawing of the board,
+// so any larger miss is a typo or a wrong L1/L2, not a measurement error.
+inline constexpr double kMarkerGeometryTolMm = 1e-6;
+
+// --- CAD import ----------------------------------------------------------------
+// (frontend/cad_*.cpp, passes/cad_to_program.cpp; docs/import.md)
+
+// Lengths read from a placement list, and the board origins of a panel, are
+// rounded to a nanometre: KiCad's own internal unit, far below any placing
+// tolerance, so nothing real is lost, and a converted value prints as the
+// short decimal it is (175 mil = 4.445 mm, not 4.4450000000000003).
+inline constexpr double kCadResolutionMm = 1e-6;
+// Rotations after the side and offset conventions, likewise (a micro-degree).
+inline constexpr double kCadResolutionDeg = 1e-6;
+
+// --- periphery calibration ---------------------------------------------------
+// (passes/fixture_estimation.cpp; the C runtime runtime/c/ repeats these values
+// as SMTCAL_* macros and a test keeps them equal; docs/periphery.md)
+
+// Two trips of one edge closer than this define no line: the sensor's own
+// accuracy is +-0.05 mm, so trips 0.01 mm apart are one trip seen twice.
+inline constexpr double kMinTripSeparationMm = 0.01;
+// Two fitted lines that cross at an angle whose sine is below this (about
+// 5.7 degrees) have no usable crossing: an error e across either line moves
+// the crossing by e / sin, ten times e here. Marker edges cross at 90 degrees.
+inline constexpr double kMinLineCrossingSin = 0.1;
+// A 2 x 2 least-squares system whose determinant is below this fraction of
+// its squared trace is singular (the edges do not fix the pose): relative
+// conditioning worse than 1e12, where double arithmetic has no digits left
+// for a pose.
+inline constexpr double kMinRelativeDeterminant = 1e-12;
+// The rigid estimator's Newton steps on the rotation stop below this step
+// (radians: it moves a point 1 m away by 1e-12 mm) or after
+// kRigidMaxIterations (from the similarity solution, 3 to 5 steps suffice).
+inline constexpr double kRigidStepTolRad = 1e-15;
+inline constexpr int kRigidMaxIterations = 20;
+// SensorShareMm differentiates the estimator by central differences with this
+// trip displacement: small against the 0.05 mm accuracy it scales, large
+// against rounding (relative error about 1e-8).
+inline constexpr double kSensorShareStepMm = 1e-4;
+
 }  // namespace smtcal

@@ -33,5 +33,9 @@ int ReportIoError(const Error& error);
 void AddCheckCommand(CLI::App& app, GlobalOptions& options);
 void AddFmtCommand(CLI::App& app, GlobalOptions& options);
 void AddTableCommand(CLI::App& app, GlobalOptions& options);
+void AddCompileCommand(CLI::App& app, GlobalOptions& options);  // compile and verify
+void AddFixtureCommand(CLI::App& app, GlobalOptions& options);
+void AddImportCommand(CLI::App& app, GlobalOptions& options);
+void AddCellCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

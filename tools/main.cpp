@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
   AddCheckCommand(app, options);
   AddFmtCommand(app, options);
   AddTableCommand(app, options);
+  AddCompileCommand(app, options);
+  AddFixtureCommand(app, options);
+  AddImportCommand(app, options);
+  AddCellCommand(app, options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

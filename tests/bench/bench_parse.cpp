@@ -1,21 +1,14 @@
 // Parse + check of a generated 100 000-line program (target: < 1 s, < 300 MB).
 // Peak resident memory of the whole process is reported as a counter.
-#include <sys/resource.h>
-
 #include <benchmark/benchmark.h>
 
 #include "frontend/parse.h"
 #include "passes/pass_manager.h"
+#include "tests/bench/bench_support.h"
 #include "tests/bench/program_generator.h"
 
 namespace smtcal {
 namespace {
-
-double PeakRssMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
-}
 
 void BM_ParseAndCheck100kLines(benchmark::State& state) {
   const std::string text = bench::GenerateProgram(100000);
@@ -34,7 +27,7 @@ void BM_ParseAndCheck100kLines(benchmark::State& state) {
   }
   state.counters["errors"] = static_cast<double>(errors);
   state.counters["lines"] = 100000;
-  state.counters["peak_rss_mb"] = PeakRssMb();
+  state.counters["peak_rss_mb"] = bench::PeakRssMb();
 }
 BENCHMARK(BM_ParseAndCheck100kLines)->Unit(benchmark::kMillisecond)->Iterations(3);
 

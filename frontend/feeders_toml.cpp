@@ -1,0 +1,371 @@
+// Reading the feeders file of `smtcal import` and matching parts to feeders
+// (see feeders_toml.h). toml++ parses; every key is checked here and each
+// mistake is reported at its own line and column, reading on so one run
+// shows all of them.
+#include "frontend/feeders_toml.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "frontend/cad_text.h"
+#include "passes/limits.h"
+#include "passes/tolerances.h"
+
+namespace smtcal::cad {
+namespace {
+
+std::string Lower(std::string_view text) {
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower;
+}
+
+std::string_view TypeName(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+class Reader {
+ public:
+  Reader(const SourceManager& sources, std::uint32_t file, Diagnostics& diags)
+      : sources_(sources), file_(file), diags_(diags) {}
+
+  // toml++ counts columns in code points; our locations count bytes.
+  SourceLoc At(const toml::source_position& position) const {
+    if (position.line == 0) return SourceLoc{file_, 1, 1};
+    std::string_view line = sources_.File(file_).Line(position.line);
+    std::size_t byte = 0;
+    for (std::uint32_t code_point = 1; code_point < position.column && byte < line.size(); ++code_point) {
+      ++byte;
+      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
+    }
+    return SourceLoc{file_, position.line, static_cast<std::uint32_t>(byte + 1)};
+  }
+  SourceRange Range(const toml::source_region& region) const {
+    SourceLoc begin = At(region.begin);
+    if (region.end.line != region.begin.line || region.end.column <= region.begin.column) return SourceRange(begin);
+    return SourceRange(begin, At(region.end).column - begin.column);
+  }
+  SourceRange Range(const toml::node& node) const { return Range(node.source()); }
+
+  std::optional<FeedersFile> Read(const toml::table& root) {
+    const std::size_t errors_before = diags_.error_count();
+    FeedersFile file;
+    file.file = file_;
+    CheckKeys(root, "the feeders file", {"feeder", "map"});
+    for (const toml::table* table : Tables(root, "feeder")) {
+      if (std::optional<FeederSpec> feeder = Feeder(*table)) file.feeders.push_back(std::move(*feeder));
+    }
+    for (const toml::table* table : Tables(root, "map")) {
+      if (std::optional<FeederRule> rule = Rule(*table)) file.rules.push_back(std::move(*rule));
+    }
+    if (diags_.error_count() != errors_before) return std::nullopt;
+    return file;
+  }
+
+ private:
+  void CheckKeys(const toml::table& table, std::string_view where, std::vector<std::string> known) {
+    for (const auto& [key, node] : table) {
+      (void)node;
+      if (std::find(known.begin(), known.end(), key.str()) != known.end()) continue;
+      std::string closest = ClosestName(key.str(), known);
+      std::string keys;
+      for (std::size_t i = 0; i < known.size(); ++i) {
+        keys += (i == 0 ? "" : i + 1 == known.size() ? " and " : ", ") + fmt::format("'{}'", known[i]);
+      }
+      diags_.Report(DiagKind::FeedersUnknownKey, Range(key.source()), Printable(key.str()), where,
+                    closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), keys);
+    }
+  }
+
+  std::vector<const toml::table*> Tables(const toml::table& root, std::string_view key) {
+    std::vector<const toml::table*> tables;
+    const toml::node* node = root.get(key);
+    if (node == nullptr) return tables;
+    const toml::array* array = node->as_array();
+    if (array == nullptr || !array->is_array_of_tables()) {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, fmt::format("tables written [[{}]]", key),
+                    TypeName(*node));
+      return tables;
+    }
+    for (const toml::node& item : *array) tables.push_back(item.as_table());
+    return tables;
+  }
+
+  std::optional<std::string> String(const toml::table& table, std::string_view key, SourceRange* range = nullptr) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    if (range != nullptr) *range = Range(*node);
+    if (!node->is_string()) {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a string", TypeName(*node));
+      return std::nullopt;
+    }
+    return *node->value<std::string>();
+  }
+
+  std::optional<double> Number(const toml::table& table, std::string_view key, double limit, std::string_view unit) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    if (!node->is_number()) {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a number", TypeName(*node));
+      return std::nullopt;
+    }
+    double value = *node->value<double>();
+    if (!std::isfinite(value) || std::abs(value) > limit) {
+      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, fmt::format("within ±{} {}", limit, unit),
+                    fmt::format("{}", value));
+      return std::nullopt;
+    }
+    return value;
+  }
+
+  std::optional<int> Count(const toml::table& table, std::string_view key, SourceRange* range = nullptr) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    if (range != nullptr) *range = Range(*node);
+    if (!node->is_integer()) {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a whole number", TypeName(*node));
+      return std::nullopt;
+    }
+    std::int64_t value = *node->value<std::int64_t>();
+    if (value < 1 || value > (1 << 20)) {
+      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, "a whole number of at least 1", value);
+      return std::nullopt;
+    }
+    return static_cast<int>(value);
+  }
+
+  // [x, y, z, u]: mm and degrees in the robot base frame.
+  std::optional<std::array<double, 4>> Point(const toml::table& table, std::string_view key) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    const toml::array* array = node->as_array();
+    if (array == nullptr || array->size() != 4 ||
+        !std::all_of(array->begin(), array->end(), [](const toml::node& n) { return n.is_number(); })) {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "[x, y, z, u]: four numbers (mm, mm, mm, deg)",
+                    array == nullptr ? std::string(TypeName(*node)) : fmt::format("an array of {} items", array->size()));
+      return std::nullopt;
+    }
+    std::array<double, 4> point{};
+    for (std::size_t i = 0; i < 4; ++i) point[i] = *array->get(i)->value<double>();
+    for (std::size_t i = 0; i < 4; ++i) {
+      double limit = i == 3 ? limits::kMaxAbsAngleDeg : kMaxLengthMm;
+      if (!std::isfinite(point[i]) || std::abs(point[i]) > limit) {
+        diags_.Report(DiagKind::FeedersBadValue, Range(*array->get(i)), fmt::format("{}[{}]", key, i + 1),
+                      fmt::format("within ±{} {}", limit, i == 3 ? "deg" : "mm"), fmt::format("{}", point[i]));
+        return std::nullopt;
+      }
+    }
+    return point;
+  }
+
+  std::optional<FeederSpec> Feeder(const toml::table& table) {
+    const std::size_t errors_before = diags_.error_count();
+    FeederSpec feeder;
+    feeder.range = Range(table);
+    CheckKeys(table, "[[feeder]]", {"name", "pick", "package", "value", "rotation_offset_deg", "pallet"});
+    if (std::optional<std::string> name = String(table, "name", &feeder.name_range)) feeder.name = *name;
+    if (!table.contains("name")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'name'");
+    if (std::optional<std::array<double, 4>> pick = Point(table, "pick")) feeder.pick = *pick;
+    if (!table.contains("pick")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'pick'");
+    if (const toml::node* package = table.get("package")) {
+      if (package->is_string()) {
+        feeder.packages.push_back(*package->value<std::string>());
+      } else if (const toml::array* list = package->as_array();
+                 list != nullptr && !list->empty() &&
+                 std::all_of(list->begin(), list->end(), [](const toml::node& n) { return n.is_string(); })) {
+        for (const toml::node& item : *list) feeder.packages.push_back(*item.value<std::string>());
+      } else {
+        diags_.Report(DiagKind::FeedersWrongType, Range(*package), "package",
+                      "a package name or an array of package names", TypeName(*package));
+      }
+    }
+    if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
+    feeder.rotation_offset_deg =
+        Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    if (const toml::node* node = table.get("pallet")) {
+      if (const toml::table* pallet = node->as_table()) {
+        CheckKeys(*pallet, "the pallet", {"last", "back", "columns", "rows"});
+        feeder.pallet_last = Point(*pallet, "last");
+        feeder.pallet_back = Point(*pallet, "back");
+        feeder.columns = Count(*pallet, "columns").value_or(1);
+        feeder.rows = Count(*pallet, "rows").value_or(1);
+        for (std::string_view key : {"last", "back", "columns", "rows"}) {
+          if (!pallet->contains(key)) {
+            diags_.Report(DiagKind::FeedersMissingKey, Range(*node), "the pallet", fmt::format("'{}'", key));
+          }
+        }
+      } else {
+        diags_.Report(DiagKind::FeedersWrongType, Range(*node), "pallet",
+                      "a table { last = [x, y, z, u], back = [x, y, z, u], columns = N, rows = N }", TypeName(*node));
+      }
+    }
+    if (diags_.error_count() != errors_before) return std::nullopt;
+    return feeder;
+  }
+
+  std::optional<FeederRule> Rule(const toml::table& table) {
+    const std::size_t errors_before = diags_.error_count();
+    FeederRule rule;
+    rule.range = Range(table);
+    CheckKeys(table, "[[map]]", {"feeder", "lane", "package", "value", "designator", "rotation_offset_deg"});
+    if (std::optional<std::string> feeder = String(table, "feeder", &rule.feeder_range)) rule.feeder = *feeder;
+    if (!table.contains("feeder")) diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]", "'feeder'");
+    rule.package = String(table, "package").value_or("");
+    rule.value = String(table, "value").value_or("");
+    rule.designator = String(table, "designator").value_or("");
+    if (!table.contains("package") && !table.contains("value") && !table.contains("designator")) {
+      diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]",
+                    "'package', 'value' or 'designator' to say which parts it maps");
+    }
+    rule.lane = Count(table, "lane", &rule.lane_range);
+    rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    if (diags_.error_count() != errors_before) return std::nullopt;
+    return rule;
+  }
+
+  const SourceManager& sources_;
+  std::uint32_t file_;
+  Diagnostics& diags_;
+};
+
+FeederSpec FromCell(const cell::Feeder& feeder) {
+  FeederSpec spec;
+  spec.name = feeder.name;
+  spec.name_range = feeder.name_range;
+  spec.range = feeder.range;
+  spec.pick = feeder.pick;
+  spec.pallet_last = feeder.pallet_last;
+  spec.pallet_back = feeder.pallet_back;
+  spec.columns = feeder.columns;
+  spec.rows = feeder.rows;
+  spec.packages = feeder.packages;
+  if (spec.packages.empty() && !feeder.package.empty()) spec.packages.push_back(feeder.package);
+  spec.value = feeder.value;
+  spec.from_cell = true;
+  return spec;
+}
+
+std::string WhereDefined(const FeederSpec& feeder, const SourceManager& sources) {
+  const SourceLoc& loc = feeder.name_range.begin;
+  if (!loc.known()) return feeder.from_cell ? "in the cell" : "in this file";
+  return fmt::format("at {}:{}", sources.File(loc.file).name, loc.line);
+}
+
+// How specifically a feeder's package and value describe a part: 2 both
+// given and matching, 1 one given and matching, 0 no match (or nothing
+// given: such a feeder is only reached through a [[map]]).
+int Specificity(const FeederSpec& feeder, const Row& row, std::optional<int>& lane) {
+  if (feeder.packages.empty() && feeder.value.empty()) return 0;
+  int score = 0;
+  if (!feeder.packages.empty()) {
+    auto it = std::find_if(feeder.packages.begin(), feeder.packages.end(),
+                           [&](const std::string& pattern) { return GlobMatch(pattern, row.package); });
+    if (it == feeder.packages.end()) return 0;
+    // A pallet with one package per pick point is a bank of lanes.
+    if (feeder.is_pallet() && static_cast<int>(feeder.packages.size()) == feeder.pick_points() &&
+        feeder.pick_points() > 1) {
+      lane = static_cast<int>(it - feeder.packages.begin()) + 1;
+    }
+    ++score;
+  }
+  if (!feeder.value.empty()) {
+    if (!GlobMatch(feeder.value, row.value)) return 0;
+    ++score;
+  }
+  return score;
+}
+
+}  // namespace
+
+Result<std::optional<FeedersFile>> LoadFeeders(const std::string& path, SourceManager& sources, Diagnostics& diags) {
+  Result<std::uint32_t> file = sources.Load(path);
+  if (!file) return file.error();
+  const SourceFile& source = sources.File(file.value());
+  Reader reader(sources, file.value(), diags);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(source.text), std::string_view(source.name));
+  } catch (const toml::parse_error& error) {
+    diags.Report(DiagKind::FeedersSyntax, SourceRange(reader.At(error.source().begin)),
+                 std::string(error.description()));
+    return std::optional<FeedersFile>();
+  }
+  return reader.Read(root);
+}
+
+std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& cell_feeders, FeedersFile file,
+                                              Diagnostics& diags) {
+  const std::size_t errors_before = diags.error_count();
+  FeederTable table;
+  for (const cell::Feeder& feeder : cell_feeders) table.feeders_.push_back(FromCell(feeder));
+  auto find = [&](std::string_view name) -> std::optional<std::size_t> {
+    for (std::size_t i = 0; i < table.feeders_.size(); ++i) {
+      if (Lower(table.feeders_[i].name) == Lower(name)) return i;
+    }
+    return std::nullopt;
+  };
+  for (FeederSpec& feeder : file.feeders) {
+    if (std::optional<std::size_t> first = find(feeder.name)) {
+      diags.Report(DiagKind::FeedersDuplicateFeeder, feeder.name_range, Printable(feeder.name),
+                   WhereDefined(table.feeders_[*first], diags.sources()));
+      continue;
+    }
+    table.feeders_.push_back(std::move(feeder));
+  }
+  std::vector<std::string> names;
+  for (const FeederSpec& feeder : table.feeders_) names.push_back(feeder.name);
+  for (FeederRule& rule : file.rules) {
+    std::optional<std::size_t> feeder = find(rule.feeder);
+    if (!feeder) {
+      std::string closest = ClosestName(rule.feeder, names);
+      diags.Report(DiagKind::FeedersUnknownFeeder, rule.feeder_range, Printable(rule.feeder),
+                   closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
+      continue;
+    }
+    const FeederSpec& spec = table.feeders_[*feeder];
+    if (rule.lane && *rule.lane > spec.pick_points()) {
+      diags.Report(DiagKind::FeedersBadValue, rule.lane_range, "lane",
+                   fmt::format("a pick point of feeder '{}' (1 to {})", Printable(spec.name), spec.pick_points()),
+                   *rule.lane);
+      continue;
+    }
+    table.rule_feeder_.push_back(*feeder);
+    table.rules_.push_back(std::move(rule));
+  }
+  if (diags.error_count() != errors_before) return std::nullopt;
+  return table;
+}
+
+std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
+  for (std::size_t r = 0; r < rules_.size(); ++r) {
+    const FeederRule& rule = rules_[r];
+    if (!rule.package.empty() && !GlobMatch(rule.package, row.package)) continue;
+    if (!rule.value.empty() && !GlobMatch(rule.value, row.value)) continue;
+    if (!rule.designator.empty() && !GlobMatch(rule.designator, row.designator)) continue;
+    return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg};
+  }
+  std::optional<FeederMatch> best;
+  int best_score = 0;
+  for (std::size_t f = 0; f < feeders_.size(); ++f) {
+    std::optional<int> lane;
+    int score = Specificity(feeders_[f], row, lane);
+    if (score > best_score) {
+      best_score = score;
+      best = FeederMatch{f, lane, feeders_[f].rotation_offset_deg};
+    }
+  }
+  return best;
+}
+
+}  // namespace smtcal::cad

@@ -1,0 +1,193 @@
+// `smtcal cell check CELL.toml`: load a cell file (docs/cell.md) with its
+// error tables, report every mistake in it, and print a short summary of what
+// it describes (text, or JSON with --json). The loading and all the checks
+// are in frontend/cell_toml.cpp; this file only wires the file, the options,
+// the summary and the exit codes.
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "frontend/cell.h"
+#include "passes/fixture_geometry.h"
+#include "tools/commands.h"
+
+namespace smtcal::tools {
+namespace {
+
+using nlohmann::ordered_json;
+
+// Numbers as the user wrote them: the shortest form that reads back.
+std::string Num(double value) { return fmt::format("{}", value); }
+
+std::string Range(const cell::Interval& interval) { return fmt::format("{}..{}", Num(interval.lo), Num(interval.hi)); }
+
+std::string Point(const std::array<double, 4>& p) {
+  return fmt::format("({}, {}, {}, {})", Num(p[0]), Num(p[1]), Num(p[2]), Num(p[3]));
+}
+
+std::string Axes(const cell::Region& region) {
+  std::string axes;
+  for (cell::TaskAxis axis : region.difficulty_axes) {
+    axes += fmt::format("{}{}", axes.empty() ? "" : ", ", cell::TaskAxisName(axis));
+  }
+  return axes;
+}
+
+std::string Join(const std::vector<std::string>& items, std::string_view separator) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : std::string(separator)) + item;
+  return text;
+}
+
+std::string SummaryText(const cell::Cell& cell) {
+  std::string out = fmt::format("cell '{}' ({})\n", cell.name, cell.path);
+  const cell::Robot& robot = cell.robot;
+  out += fmt::format("robot {}: x {} mm, y {} mm, z {} mm, u {} deg; repeatability ±{} mm; safe LimZ {} mm\n",
+                     robot.model.empty() ? "(no model given)" : robot.model, Range(robot.limits[0]),
+                     Range(robot.limits[1]), Range(robot.limits[2]), Range(robot.limits[3]),
+                     Num(robot.repeatability_mm), Num(robot.safe_limz_mm));
+  out += fmt::format("  motion: xy {} mm/s, {} mm/s²; z {} mm/s, {} mm/s²; u {} deg/s, {} deg/s²; "
+                     "pick {} s, place {} s\n",
+                     Num(robot.xy_speed_mm_s), Num(robot.xy_accel_mm_s2), Num(robot.z_speed_mm_s),
+                     Num(robot.z_accel_mm_s2), Num(robot.u_speed_deg_s), Num(robot.u_accel_deg_s2),
+                     Num(robot.pick_time_s), Num(robot.place_time_s));
+
+  out += fmt::format("regions: {}\n", cell.regions.size());
+  for (const cell::Region& region : cell.regions) {
+    out += fmt::format("  {}: x {}, y {} mm; table {} (domain x {}..{}, y {}..{} mm); D = ({}, {{{}}}); "
+                       "tolerance ±{} mm; outside {}\n",
+                       region.name, Range(region.x_mm), Range(region.y_mm), region.table_path, Num(region.domain.x0),
+                       Num(region.domain.x1), Num(region.domain.y0), Num(region.domain.y1), region.difficulty_level,
+                       Axes(region), Num(region.tolerance_mm), cell::OutsidePolicyName(region.outside));
+  }
+
+  out += fmt::format("fixtures: {}\n", cell.fixtures.size());
+  for (const cell::Fixture& fixture : cell.fixtures) {
+    std::string teach = fixture.teach_trips_mm.empty()
+                            ? "no (taught points cannot use it)"
+                            : fmt::format("yes ({} trips)", fixture.teach_trips_mm.size());
+    out += fmt::format("  {}: origin ({}, {}) mm, angle {} deg; L1 {} mm, L2 {} mm; {} scan path(s), {} trips; "
+                       "estimator {}; teach scan {}\n",
+                       fixture.name, Num(fixture.origin_mm.x()), Num(fixture.origin_mm.y()), Num(fixture.angle_deg),
+                       Num(fixture.l1_mm), Num(fixture.l2_mm), fixture.scan_paths.size(),
+                       ExpectedTrips(fixture).size(), cell::EstimatorName(fixture.estimator), teach);
+  }
+
+  out += fmt::format("feeders: {}\n", cell.feeders.size());
+  for (const cell::Feeder& feeder : cell.feeders) {
+    std::string line = fmt::format("  {}: pick {}", feeder.name, Point(feeder.pick));
+    if (feeder.pallet_last && feeder.pallet_back) {
+      line += fmt::format("; pallet {} x {}, last {}, back {}", feeder.columns, feeder.rows,
+                          Point(*feeder.pallet_last), Point(*feeder.pallet_back));
+    }
+    if (!feeder.packages.empty()) line += fmt::format("; package {}", Join(feeder.packages, ", "));
+    if (!feeder.value.empty()) line += fmt::format("; value {}", feeder.value);
+    out += line + "\n";
+  }
+  return out;
+}
+
+ordered_json Pair(double a, double b) { return ordered_json::array({a, b}); }
+ordered_json Pair(const cell::Interval& interval) { return Pair(interval.lo, interval.hi); }
+
+std::string SummaryJson(const cell::Cell& cell) {
+  ordered_json out;
+  out["name"] = cell.name;
+  out["path"] = cell.path;
+  const cell::Robot& robot = cell.robot;
+  out["robot"] = {{"model", robot.model},
+                  {"x_mm", Pair(robot.limits[0])},
+                  {"y_mm", Pair(robot.limits[1])},
+                  {"z_mm", Pair(robot.limits[2])},
+                  {"u_deg", Pair(robot.limits[3])},
+                  {"repeatability_mm", robot.repeatability_mm},
+                  {"safe_limz_mm", robot.safe_limz_mm},
+                  {"xy_speed_mm_s", robot.xy_speed_mm_s},
+                  {"xy_accel_mm_s2", robot.xy_accel_mm_s2},
+                  {"z_speed_mm_s", robot.z_speed_mm_s},
+                  {"z_accel_mm_s2", robot.z_accel_mm_s2},
+                  {"u_speed_deg_s", robot.u_speed_deg_s},
+                  {"u_accel_deg_s2", robot.u_accel_deg_s2},
+                  {"pick_time_s", robot.pick_time_s},
+                  {"place_time_s", robot.place_time_s}};
+  out["regions"] = ordered_json::array();
+  for (const cell::Region& region : cell.regions) {
+    ordered_json axes = ordered_json::array();
+    for (cell::TaskAxis axis : region.difficulty_axes) axes.push_back(cell::TaskAxisName(axis));
+    out["regions"].push_back(
+        {{"name", region.name},
+         {"x_mm", Pair(region.x_mm)},
+         {"y_mm", Pair(region.y_mm)},
+         {"table", region.table_path},
+         {"domain", {{"x_mm", Pair(region.domain.x0, region.domain.x1)},
+                     {"y_mm", Pair(region.domain.y0, region.domain.y1)}}},
+         {"difficulty", {{"level", region.difficulty_level}, {"axes", axes}}},
+         {"tolerance_mm", region.tolerance_mm},
+         {"outside", cell::OutsidePolicyName(region.outside)}});
+  }
+  out["fixtures"] = ordered_json::array();
+  for (const cell::Fixture& fixture : cell.fixtures) {
+    ordered_json paths = ordered_json::array();
+    for (const cell::ScanPath& path : fixture.scan_paths) paths.push_back(path.name);
+    out["fixtures"].push_back(
+        {{"name", fixture.name},
+         {"origin_mm", Pair(fixture.origin_mm.x(), fixture.origin_mm.y())},
+         {"angle_deg", fixture.angle_deg},
+         {"l1_mm", fixture.l1_mm},
+         {"l2_mm", fixture.l2_mm},
+         {"scan_paths", paths},
+         {"trips", ExpectedTrips(fixture).size()},
+         {"estimator", cell::EstimatorName(fixture.estimator)},
+         {"teach_scan", !fixture.teach_trips_mm.empty()},
+         {"teach_trips", fixture.teach_trips_mm.size()}});
+  }
+  out["feeders"] = ordered_json::array();
+  for (const cell::Feeder& feeder : cell.feeders) {
+    ordered_json entry = {{"name", feeder.name}, {"pick", feeder.pick}};
+    if (feeder.pallet_last && feeder.pallet_back) {
+      entry["pallet"] = {{"last", *feeder.pallet_last},
+                         {"back", *feeder.pallet_back},
+                         {"columns", feeder.columns},
+                         {"rows", feeder.rows}};
+    }
+    entry["packages"] = feeder.packages;
+    entry["value"] = feeder.value;
+    out["feeders"].push_back(entry);
+  }
+  return out.dump(2) + "\n";
+}
+
+void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, sources, diags);
+  if (!loaded) {
+    options.exit_code = ReportIoError(loaded.error());
+    return;
+  }
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (!loaded.value()) return;  // the errors were printed
+  const cell::Cell& cell = *loaded.value();
+  Status written = WriteFileAtomically("-", json ? SummaryJson(cell) : SummaryText(cell));
+  if (!written) options.exit_code = ReportIoError(written.error());
+}
+
+}  // namespace
+
+void AddCellCommand(CLI::App& app, GlobalOptions& options) {
+  static std::string path;
+  static bool json = false;
+  CLI::App* cell = app.add_subcommand(
+      "cell", "Check cell files (*.cell.toml): robot, calibrated regions, fixtures, feeders (docs/cell.md)");
+  cell->require_subcommand(1);
+  CLI::App* check = cell->add_subcommand(
+      "check", "Load a cell file and its error tables, report every mistake (exit 1), and print a summary:\n"
+               "the robot, each region (bounds, table domain, difficulty, tolerance, policy), each fixture\n"
+               "(pose, L1/L2, scan trips, estimator, teach scan) and each feeder");
+  check->add_option("CELL", path,
+                    "the cell file ('-' for stdin; its table paths are then relative to the current directory)")
+      ->required();
+  check->add_flag("--json", json, "print the summary as JSON instead of text");
+  check->callback([&options] { RunCheck(path, json, options); });
+}
+
+}  // namespace smtcal::tools

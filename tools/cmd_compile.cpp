@@ -1,0 +1,190 @@
+// smtcal compile / smtcal verify: a .place program plus a cell file through
+// the checks and the correction passes; compile also emits the corrected
+// program, verify only reports.
+#include <fmt/core.h>
+
+// WIP #include "backend/c_data.h"
+#include "backend/compile_report.h"
+#include "backend/place_printer.h"
+#include "frontend/cell.h"
+#include "frontend/parse.h"
+#include "passes/compile_state.h"
+#include "passes/correction_passes.h"
+#include "passes/pass_manager.h"
+#include "tools/commands.h"
+
+namespace smtcal::tools {
+namespace {
+
+struct CompileOptions {
+  std::string program_path;
+  std::string cell_path;
+  std::string target = "place";
+  std::string output;
+  std::string report;
+  bool json = false;
+  bool verify_each = false;
+};
+
+// Parse, check, load the cell and run the correction passes. Returns false
+// (with options.exit_code set and everything printed) when there is nothing
+// to emit.
+struct Compiled {
+  ir::Program program;
+  std::optional<cell::Cell> cell;
+};
+
+bool CompileProgram(const CompileOptions& opt, SourceManager& sources, Diagnostics& diags, Compiled& out,
+                    GlobalOptions& options) {
+  Result<std::uint32_t> file = sources.Load(opt.program_path);
+  if (!file) {
+    options.exit_code = ReportIoError(file.error());
+    return false;
+  }
+  out.program = ParseProgram(file.value(), diags);
+  if (!diags.has_errors()) {
+    std::vector<const PassInfo*> checks;
+    for (const PassInfo& info : PassRegistry()) checks.push_back(&info);
+    RunPasses(out.program, diags, checks, opt.verify_each);
+  }
+  // The cell is loaded even when the program has errors, so both sets of
+  // mistakes are reported at once.
+  Result<std::optional<cell::Cell>> cell = cell::LoadCell(opt.cell_path, sources, diags);
+  if (!cell) {
+    PrintDiagnostics(diags, options);
+    options.exit_code = ReportIoError(cell.error());
+    return false;
+  }
+  out.cell = std::move(cell).value();
+  if (diags.has_errors() || !out.cell) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return false;
+  }
+  out.program.compile = std::make_shared<CompileState>();
+  out.program.compile->cell = &*out.cell;
+  std::vector<const PassInfo*> corrections;
+  for (const PassInfo& info : CorrectionPassRegistry()) corrections.push_back(&info);
+  RunPasses(out.program, diags, corrections, opt.verify_each);
+  return true;
+}
+
+ReportCounts Counts(const Diagnostics& diags) {
+  return {static_cast<int>(diags.error_count()), static_cast<int>(diags.warning_count())};
+}
+
+// The corrected program says at its top what it is.
+void AddHeader(ir::Program& program, const cell::Cell& cell) {
+  std::vector<std::string> lines = {
+      fmt::format(" Corrected by smtcal {} for cell '{}' ({}). Do not edit; compile the source again.", SMTCAL_VERSION,
+                  cell.name, cell.path),
+      " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
+      " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
+  };
+  ir::Block header;
+  for (const std::string& line : lines) {
+    auto stmt = std::make_unique<ir::Stmt>();
+    stmt->loc = program.items.empty() ? SourceLoc{} : program.items.front()->loc;
+    stmt->node = ir::Comment{line};
+    header.push_back(std::move(stmt));
+  }
+  program.items.insert(program.items.begin(), std::make_move_iterator(header.begin()),
+                       std::make_move_iterator(header.end()));
+}
+
+#if 0  // WIP
+std::vector<CRuntimePoint> FixturePoints(const CompileState& state) {
+  std::vector<CRuntimePoint> points;
+  for (const Target& target : state.targets) {
+    if (target.kind != CorrectionKind::kFixture || !target.known) continue;
+    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].name,
+                                   Eigen::Vector2d(target.in_frame[0], target.in_frame[1]), target.in_frame[2],
+                                   target.in_frame[3], target.stmt->loc});
+  }
+  return points;
+}
+
+std::string ProgramName(const ir::Program& program) {
+  for (const ir::StmtPtr& item : program.items) {
+    if (const auto* decl = std::get_if<ir::ProgramDecl>(&item->node)) return decl->name;
+  }
+  return "program";
+}
+#endif
+
+void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Compiled compiled;
+  if (!CompileProgram(opt, sources, diags, compiled, options)) return;
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (diags.has_errors()) return;  // nothing half-written
+  const CompileState& state = *compiled.program.compile;
+  std::string text;
+  if (opt.target == "c") {
+    // WIP text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
+  } else {
+    AddHeader(compiled.program, *compiled.cell);
+    text = PrintPlace(compiled.program);
+  }
+  if (!opt.report.empty()) {
+    std::string report = CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n";
+    if (Status written = WriteFileAtomically(opt.report, report); !written) {
+      options.exit_code = ReportIoError(written.error());
+      return;
+    }
+  }
+  if (Status written = WriteFileAtomically(opt.output, text); !written) {
+    options.exit_code = ReportIoError(written.error());
+  }
+}
+
+void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Compiled compiled;
+  if (!CompileProgram(opt, sources, diags, compiled, options)) return;
+  options.exit_code = PrintDiagnostics(diags, options);
+  const CompileState& state = *compiled.program.compile;
+  std::string text = opt.json ? CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n"
+                              : VerifySummaryText(compiled.program, state, sources, Counts(diags));
+  fmt::print("{}", text);
+}
+
+void AddCommonOptions(CLI::App& command, CompileOptions& opt) {
+  command.add_option("PROGRAM", opt.program_path, "the .place program ('-' for stdin)")->required();
+  command.add_option("--cell", opt.cell_path, "the cell file (*.cell.toml, docs/cell.md)")->required();
+  command.add_flag("--verify-each", opt.verify_each,
+                   "verify the IR after every pass and name the pass that broke it (for debugging smtcal)");
+  command.footer("Correction passes, in order (after the checks of `smtcal check`):\n" +
+                 DescribePasses(CorrectionPassRegistry()));
+}
+
+}  // namespace
+
+void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
+  static CompileOptions compile_options;
+  CLI::App* compile = app.add_subcommand(
+      "compile", "Correct a .place program for a cell: static targets inverted through the error tables, taught "
+                 "points converted, a Scan injected into every Cycle; write the corrected program");
+  AddCommonOptions(*compile, compile_options);
+  compile->add_option("--target", compile_options.target,
+                      "what to write: place (the corrected program, same language) or c (the program's fixture "
+                      "points and the cell's tables as C data for runtime/c)")
+      ->check(CLI::IsMember({"place", "c"}))
+      ->capture_default_str();
+  compile->add_option("-o,--output", compile_options.output, "the file to write ('-' for stdout)")->required();
+  compile->add_option("--report", compile_options.report,
+                      "also write a JSON report of every motion target (required and nominal position, correction, "
+                      "region, residual, budget) and the cycle-time estimate");
+  compile->callback([&options] { RunCompile(compile_options, options); });
+
+  static CompileOptions verify_options;
+  CLI::App* verify = app.add_subcommand(
+      "verify", "Run the checks and correction passes for a cell without writing anything; print a summary "
+                "(exit 1 when anything is out of tolerance)");
+  AddCommonOptions(*verify, verify_options);
+  verify->add_flag("--json", verify_options.json, "print the JSON report instead of the summary");
+  verify->callback([&options] { RunVerify(verify_options, options); });
+}
+
+}  // namespace smtcal::tools

@@ -1,0 +1,338 @@
+// smtcal import LIST --cell CELL.toml [--feeders FEEDERS.toml] -o BOARD.place:
+// a CAD placement list into a .place program (docs/import.md). The work is in
+// frontend/cad_reader (the list), frontend/feeders_toml (which feeder holds
+// which part) and passes/cad_to_program (the program); this file wires files,
+// options and exit codes.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "backend/place_printer.h"
+#include "frontend/cad_reader.h"
+#include "frontend/cad_text.h"
+#include "frontend/cell.h"
+#include "frontend/feeders_toml.h"
+#include "passes/cad_to_program.h"
+#include "passes/limits.h"
+#include "passes/tolerances.h"
+#include "tools/commands.h"
+
+namespace smtcal::tools {
+namespace {
+
+struct ImportCliOptions {
+  std::string list;
+  std::string cell;
+  std::string feeders;
+  std::string output;
+  std::string format;
+  std::string units;
+  std::string delimiter;
+  std::string columns;
+  std::string side;
+  std::string mirror;
+  std::string bottom_rotation = "top-view";
+  std::string angles = "signed";
+  std::string origin = "0,0";
+  double rotation_deg = 0;
+  std::string panel = "1x1";
+  std::string pitch = "0,0";
+  double place_z_mm = 0;
+  int vacuum = 8;
+  bool skip_unmapped = false;
+  bool keep_dnp = false;
+  bool no_default_excludes = false;
+  std::vector<std::string> exclude_designators;
+  std::vector<std::string> exclude_packages;
+  std::string fixture;
+  std::string name;
+};
+
+std::string BaseName(const std::string& path) {
+  return path == "-" ? "<stdin>" : std::filesystem::path(path).filename().string();
+}
+
+// "X,Y" -> two finite lengths within kMaxLengthMm.
+std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
+  std::size_t comma = text.find(',');
+  if (comma == std::string::npos) return std::nullopt;
+  std::optional<double> a = cad::ParseNumber(text.substr(0, comma));
+  std::optional<double> b = cad::ParseNumber(text.substr(comma + 1));
+  if (!a || !b || !std::isfinite(*a) || !std::isfinite(*b) || std::abs(*a) > kMaxLengthMm ||
+      std::abs(*b) > kMaxLengthMm) {
+    return std::nullopt;
+  }
+  return std::array<double, 2>{*a, *b};
+}
+
+CLI::Validator PairValidator() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        return ParsePair(text) ? std::string() : "expected X,Y in mm (two numbers, e.g. 10.5,20); write --origin=-5,10 "
+                                                 "when the first is negative";
+      },
+      "X,Y");
+}
+
+// "CxR" -> columns and rows of a panel.
+std::optional<std::array<int, 2>> ParsePanel(const std::string& text) {
+  std::size_t x = text.find_first_of("xX");
+  if (x == std::string::npos) return std::nullopt;
+  try {
+    std::size_t used = 0;
+    int columns = std::stoi(text.substr(0, x), &used);
+    if (used != x) return std::nullopt;
+    int rows = std::stoi(text.substr(x + 1), &used);
+    if (used != text.size() - x - 1 || columns < 1 || rows < 1 || columns * static_cast<long>(rows) > 10000) {
+      return std::nullopt;
+    }
+    return std::array<int, 2>{columns, rows};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::optional<char> ParseDelimiter(const std::string& text) {
+  if (text == "," || text == "comma") return ',';
+  if (text == ";" || text == "semicolon") return ';';
+  if (text == "\t" || text == "tab") return '\t';
+  if (text == " " || text == "space" || text == "blank") return ' ';
+  return std::nullopt;
+}
+
+void UsageError(const std::string& option, const std::string& message) { throw CLI::ValidationError(option, message); }
+
+// The fixture the board is on: --fixture, or the cell's only one.
+const cell::Fixture* ChooseFixture(const cell::Cell& cell, const std::string& wanted, Diagnostics& diags) {
+  const SourceRange cell_start(SourceLoc{cell.file, 1, 1});
+  std::vector<std::string> names;
+  for (const cell::Fixture& fixture : cell.fixtures) names.push_back(fmt::format("'{}'", fixture.name));
+  std::string list = fmt::format("{}", fmt::join(names, ", "));
+  if (!wanted.empty()) {
+    if (const cell::Fixture* fixture = cell.FindFixture(wanted)) return fixture;
+    std::vector<std::string> plain;
+    for (const cell::Fixture& fixture : cell.fixtures) plain.push_back(fixture.name);
+    std::string closest = ClosestName(wanted, plain);
+    if (cell.fixtures.empty()) {
+      diags.Report(DiagKind::ImportNoFixture, cell_start);
+    } else {
+      diags.Report(DiagKind::ImportUnknownFixture, cell.fixtures.front().name_range, cad::Printable(wanted),
+                   closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), list);
+    }
+    return nullptr;
+  }
+  if (cell.fixtures.size() == 1) return &cell.fixtures.front();
+  if (cell.fixtures.empty()) {
+    diags.Report(DiagKind::ImportNoFixture, cell_start);
+  } else {
+    diags.Report(DiagKind::ImportChooseFixture, cell.fixtures.front().name_range, cell.fixtures.size(), list);
+  }
+  return nullptr;
+}
+
+cad::ReadOptions MakeReadOptions(const ImportCliOptions& opt) {
+  cad::ReadOptions read;
+  if (!opt.format.empty()) read.format = cad::FormatFromName(opt.format);
+  if (!opt.units.empty()) read.units = cad::UnitFromName(opt.units);
+  if (!opt.delimiter.empty()) read.delimiter = ParseDelimiter(opt.delimiter);
+  if (!opt.columns.empty()) {
+    if (read.format != cad::Format::kGenericCsv) UsageError("--columns", "--columns is for --format csv");
+    if (std::optional<std::string> error = cad::ParseColumnMapping(opt.columns, read.mapping)) {
+      UsageError("--columns", *error);
+    }
+  } else if (read.format == cad::Format::kGenericCsv) {
+    UsageError("--format", "--format csv needs --columns, e.g. --columns designator=Ref,x=X,y=Y,rotation=Rot");
+  }
+  // A list without a side column holds the side asked for; Eagle's bottom
+  // list is the .mnb file.
+  std::string lower = opt.list;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (opt.side == "bottom" || (opt.side.empty() && lower.ends_with(".mnb"))) {
+    read.side_without_column = cad::Side::kBottom;
+  }
+  return read;
+}
+
+ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture& fixture) {
+  ImportOptions import;
+  if (!opt.side.empty()) import.side = opt.side == "top" ? cad::Side::kTop : cad::Side::kBottom;
+  std::string lower = opt.list;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (opt.side.empty() && lower.ends_with(".mnb")) import.side = cad::Side::kBottom;
+  if (opt.mirror == "none") import.mirror = ImportMirror::kNone;
+  if (opt.mirror == "x") import.mirror = ImportMirror::kX;
+  if (opt.mirror == "y") import.mirror = ImportMirror::kY;
+  import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
+  import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
+  std::array<double, 2> origin = *ParsePair(opt.origin), pitch = *ParsePair(opt.pitch);
+  std::array<int, 2> panel = *ParsePanel(opt.panel);
+  import.origin_x_mm = origin[0];
+  import.origin_y_mm = origin[1];
+  import.rotation_deg = opt.rotation_deg;
+  import.columns = panel[0];
+  import.rows = panel[1];
+  import.pitch_x_mm = pitch[0];
+  import.pitch_y_mm = pitch[1];
+  import.place_z_mm = opt.place_z_mm;
+  import.vacuum = opt.vacuum;
+  import.skip_unmapped = opt.skip_unmapped;
+  import.keep_dnp = opt.keep_dnp;
+  import.default_excludes = !opt.no_default_excludes;
+  import.exclude_designators = opt.exclude_designators;
+  import.exclude_packages = opt.exclude_packages;
+  import.fixture = fixture.name;
+  std::string stem = opt.name;
+  if (stem.empty()) {
+    const std::string& from = opt.output != "-" ? opt.output : opt.list;
+    stem = from == "-" ? "Imported" : std::filesystem::path(from).stem().string();
+  }
+  import.program_name = MakeIdentifier(stem);
+  return import;
+}
+
+void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
+  cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
+  if (!loaded) {
+    PrintDiagnostics(diags, options);
+    options.exit_code = ReportIoError(loaded.error());
+    return;
+  }
+  std::optional<cell::Cell> cell = std::move(loaded).value();
+  const cell::Fixture* fixture = cell ? ChooseFixture(*cell, opt.fixture, diags) : nullptr;
+  cad::FeedersFile feeders_file;
+  if (!opt.feeders.empty()) {
+    Result<std::optional<cad::FeedersFile>> file = cad::LoadFeeders(opt.feeders, sources, diags);
+    if (!file) {
+      PrintDiagnostics(diags, options);
+      options.exit_code = ReportIoError(file.error());
+      return;
+    }
+    if (file.value()) feeders_file = std::move(*file.value());
+  }
+  if (!cell || fixture == nullptr || diags.has_errors()) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
+  std::optional<cad::FeederTable> feeders = cad::FeederTable::Build(cell->feeders, std::move(feeders_file), diags);
+  Result<std::uint32_t> list = sources.Load(opt.list);
+  if (!list) {
+    PrintDiagnostics(diags, options);
+    options.exit_code = ReportIoError(list.error());
+    return;
+  }
+  std::unique_ptr<cad::ListReader> reader = cad::OpenList(list.value(), read, diags);
+  if (!feeders || !reader) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
+
+  ImportOptions import = MakeImportOptions(opt, *fixture);
+  import.header_lines = {
+      fmt::format("Imported by smtcal import from {} ({}, {}).", BaseName(opt.list), cad::FormatTitle(reader->format()),
+                  cad::UnitName(reader->unit())),
+      fmt::format("Cell {}, fixture {}{}.", BaseName(opt.cell), fixture->name,
+                  opt.feeders.empty() ? "" : ", feeders " + BaseName(opt.feeders)),
+      "To change it, change the list, the cell, the feeders or the options and import again.",
+  };
+  CadImporter importer(*feeders, std::move(import), list.value(), diags);
+  cad::Row row;
+  while (reader->Next(row)) importer.Add(row);
+  std::optional<ir::Program> program = importer.Finish(*reader);
+  options.exit_code = PrintDiagnostics(diags, options);
+  std::fputs(FormatImportSummary(importer.summary()).c_str(), stderr);
+  if (options.exit_code != kExitOk || !program) {
+    options.exit_code = kExitInputError;
+    return;  // nothing half-written
+  }
+  Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
+  if (!written) options.exit_code = ReportIoError(written.error());
+}
+
+}  // namespace
+
+void AddImportCommand(CLI::App& app, GlobalOptions& options) {
+  static ImportCliOptions opt;
+  CLI::App* cmd = app.add_subcommand(
+      "import", "Turn a CAD placement list (KiCad, Altium, Eagle, JLCPCB, DipTrace, CSV) into a .place program\n"
+                "that picks every part from its feeder and places it on the fixture's board (docs/import.md)");
+  cmd->add_option("LIST", opt.list, "the placement list ('-' for stdin); its format is detected from the content")
+      ->required();
+  cmd->add_option("--cell", opt.cell, "the cell file: the fixture and the feeders")->required();
+  cmd->add_option("--feeders", opt.feeders, "a feeders file: more feeders and [[map]] rules (package, value, designator)");
+  cmd->add_option("-o,--output", opt.output, "the .place program to write ('-' for stdout)")->required();
+
+  // The list.
+  cmd->add_option("--format", opt.format, "the list's format when detection is not wanted")
+      ->check(CLI::IsMember({"kicad-pos", "kicad-csv", "jlcpcb", "altium", "eagle", "diptrace", "csv"}));
+  cmd->add_option("--columns", opt.columns,
+                  "for --format csv: KEY=COLUMN,... with keys designator, x, y (needed) and rotation, value,\n"
+                  "package, side, dnp; columns by header name or 1-based number (then there is no header)");
+  cmd->add_option("--units", opt.units, "unit of lengths the list writes without one and does not state: mm, mil, in "
+                                        "(default mm)")
+      ->check(CLI::IsMember({"mm", "mil", "in"}));
+  cmd->add_option("--delimiter", opt.delimiter, "field separator: comma, semicolon, tab or space (default: from the "
+                                                "header line)")
+      ->check(CLI::IsMember({",", ";", "comma", "semicolon", "tab", "space"}));
+
+  // Which parts.
+  cmd->add_option("--side", opt.side,
+                  "the side to place: top or bottom (default: the only side the list has parts on; a list\n"
+                  "without a side column is on this side, Eagle's .mnb on the bottom)")
+      ->check(CLI::IsMember({"top", "bottom"}));
+  cmd->add_flag("--skip-unmapped", opt.skip_unmapped, "leave out parts no feeder holds (each is listed) instead of "
+                                                      "failing");
+  cmd->add_flag("--keep-dnp", opt.keep_dnp, "place parts a DNP column or a DNP/DNF value marks do-not-place");
+  cmd->add_option("--exclude-designator", opt.exclude_designators, "leave out parts whose designator matches (glob, "
+                                                                   "any case; repeatable)");
+  cmd->add_option("--exclude-package", opt.exclude_packages, "leave out parts whose package matches (glob; repeatable)");
+  cmd->add_flag("--no-default-excludes", opt.no_default_excludes,
+                "place fiducials and mounting holes too (by default designators FID* and packages\n"
+                "*Fiducial*, *MountingHole* are left out)");
+
+  // Where the board is.
+  cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
+  cmd->add_option("--origin", opt.origin, "X,Y: the board origin in the fixture frame, mm (default 0,0)")
+      ->check(PairValidator());
+  cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
+      ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
+  cmd->add_option("--mirror", opt.mirror,
+                  "the board coordinate that changes sign: none, x or y (default: none for the top side, x for\n"
+                  "the bottom side, the board turned over about its y axis)")
+      ->check(CLI::IsMember({"none", "x", "y"}));
+  cmd->add_option("--bottom-rotation", opt.bottom_rotation,
+                  "how the list gives bottom-side rotations: top-view (as seen through the board from the top,\n"
+                  "mirrored with the positions) or bottom-view (as seen from below, kept)")
+      ->check(CLI::IsMember({"top-view", "bottom-view"}))
+      ->capture_default_str();
+  cmd->add_option("--panel", opt.panel, "CxR: a panel of C columns and R rows of boards (default 1x1)")
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            return ParsePanel(text) ? std::string() : "expected CxR, e.g. 3x2 (at most 10000 boards)";
+          },
+          "CxR"));
+  cmd->add_option("--pitch", opt.pitch, "DX,DY: the distance between the panel's boards along its x and y, mm")
+      ->check(PairValidator());
+  cmd->add_option("--place-z", opt.place_z_mm, "z of the placements in the board frame, mm (default 0)")
+      ->check(CLI::Range(-kMaxLengthMm, kMaxLengthMm));
+
+  // The program.
+  cmd->add_option("--vacuum", opt.vacuum, "the gripper's vacuum output, the program's Vacuum (default 8)")
+      ->check(CLI::Range(limits::kVacuumOutputMin, limits::kVacuumOutputMax))
+      ->capture_default_str();
+  cmd->add_option("--angles", opt.angles, "rotations in the program: signed (-180..180) or positive (0..360)")
+      ->check(CLI::IsMember({"signed", "positive"}))
+      ->capture_default_str();
+  cmd->add_option("--name", opt.name, "the program's name (default: from the output file's name)");
+  cmd->footer(
+      "Every row becomes a placement or a diagnostic at its line; the summary on stderr counts rows\n"
+      "read, placed and skipped by reason. Exit codes: 0 ok, 1 errors in the list, the cell or the\n"
+      "feeders, 2 bad command line, 3 a file could not be read or written.");
+  cmd->callback([&options] { RunImport(opt, options); });
+}
+
+}  // namespace smtcal::tools
