@@ -72,9 +72,9 @@ std::optional<Format> FromHeaderLine(const Lines& lines, std::uint32_t number, c
 
 std::optional<Format> DetectFormat(const Lines& lines, const SourceManager& sources) {
   const std::uint32_t last = std::min(lines.count(), kDetectLines);
+  // A preamble's signs, wherever they are in it.
   for (std::uint32_t number = 1; number <= last; ++number) {
-    std::string_view text = Unquote(lines.Text(number));
-    std::string lower = Lower(text);
+    std::string lower = Lower(Unquote(lines.Text(number)));
     if ((lower.starts_with("###") && lower.find("positions") != std::string::npos) ||
         lower.starts_with("## unit") || lower.starts_with("# ref ")) {
       return Format::kKicadPos;
@@ -82,8 +82,10 @@ std::optional<Format> DetectFormat(const Lines& lines, const SourceManager& sour
     if (lower.starts_with("altium designer pick and place") || lower.find("units used:") != std::string::npos) {
       return Format::kAltium;
     }
-    if (lines.IsFiller(number)) continue;
-    return FromHeaderLine(lines, number, sources);
+  }
+  // Else the first line with content, as a header or (Eagle) a row.
+  for (std::uint32_t number = 1; number <= last; ++number) {
+    if (!lines.IsFiller(number)) return FromHeaderLine(lines, number, sources);
   }
   return std::nullopt;
 }

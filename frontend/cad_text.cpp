@@ -32,16 +32,6 @@ bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
 
 bool IsContinuationByte(char c) { return (static_cast<unsigned char>(c) & 0xc0) == 0x80; }
 
-// Code points in text[0, end): column arithmetic for fixed-width reports,
-// whose padding counts characters, not bytes.
-std::size_t CodePoints(std::string_view text, std::size_t end) {
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < end && i < text.size(); ++i) {
-    if (!IsContinuationByte(text[i])) ++count;
-  }
-  return count;
-}
-
 // The byte offset of code point `column` (text.size() when beyond).
 std::size_t ByteOfCodePoint(std::string_view text, std::size_t column) {
   std::size_t count = 0;
@@ -137,15 +127,38 @@ bool Lines::IsFiller(std::uint32_t number) const {
 
 // ------------------------------------------------------------------ fields
 
+namespace {
+
+// The next field of a row, reusing the vector's strings: a list is read
+// row after row into the same fields, so their buffers are allocated once.
+Field& NextField(std::vector<Field>& fields, std::size_t& count) {
+  if (count == fields.size()) fields.emplace_back();
+  Field& field = fields[count++];
+  field.text.clear();
+  field.quoted = false;
+  return field;
+}
+
+void TrimInPlace(std::string& text) {
+  std::size_t end = text.size();
+  while (end > 0 && IsBlank(text[end - 1])) --end;
+  text.erase(end);
+  std::size_t begin = 0;
+  while (begin < text.size() && IsBlank(text[begin])) ++begin;
+  text.erase(0, begin);
+}
+
+}  // namespace
+
 bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, std::vector<Field>& fields,
                     Diagnostics& diags) {
-  fields.clear();
+  std::size_t count = 0;
   std::string_view line = lines.Text(number);
   std::size_t i = 0;
   while (true) {
     while (i < line.size() && IsBlank(line[i]) && line[i] != delimiter) ++i;
-    Field field;
-    field.start = CodePoints(line, i);
+    Field& field = NextField(fields, count);
+    field.start = 0;  // only blank-separated fields have columns
     const std::size_t begin = i;
     const std::uint32_t begin_line = number;
     if (i < line.size() && line[i] == '"') {
@@ -156,6 +169,7 @@ bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, s
           // RFC 4180: a line end inside quotes belongs to the field.
           if (number >= lines.count()) {
             diags.Report(DiagKind::CadUnclosedQuote, lines.Range(begin_line, begin, 1));
+            fields.resize(count);
             return false;
           }
           field.text += '\n';
@@ -172,47 +186,57 @@ bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, s
           ++i;
           break;
         }
-        field.text += line[i++];
+        std::size_t run = i;  // copy up to the next quote at once
+        while (run < line.size() && line[run] != '"') ++run;
+        field.text.append(line.substr(i, run - i));
+        i = run;
       }
       const std::size_t end = i;
       while (i < line.size() && IsBlank(line[i]) && line[i] != delimiter) ++i;
       if (i < line.size() && line[i] != delimiter) {
         diags.Report(DiagKind::CsvStrayQuote, lines.Range(number, i, 1), "text after the closing quote of a field");
+        fields.resize(count);
         return false;
       }
       field.range = begin_line == number ? lines.Range(number, begin, end - begin) : lines.Range(begin_line, begin, 1);
-      field.text = std::string(Trim(field.text));
+      TrimInPlace(field.text);
     } else {
       while (i < line.size() && line[i] != delimiter) {
         if (line[i] == '"') {
           diags.Report(DiagKind::CsvStrayQuote, lines.Range(number, i, 1), "'\"' inside an unquoted field");
+          fields.resize(count);
           return false;
         }
         ++i;
       }
       std::size_t end = i;
       while (end > begin && IsBlank(line[end - 1])) --end;
-      field.text = std::string(line.substr(begin, end - begin));
+      field.text.assign(line.substr(begin, end - begin));
       field.range = lines.Range(number, begin, end - begin);
     }
-    fields.push_back(std::move(field));
     if (i < line.size() && line[i] == delimiter) {
       ++i;
       continue;
     }
+    fields.resize(count);
     return true;
   }
 }
 
 bool SplitWhitespace(const Lines& lines, std::uint32_t number, std::vector<Field>& fields, Diagnostics& diags) {
-  fields.clear();
+  std::size_t count = 0;
   std::string_view line = lines.Text(number);
   std::size_t i = 0;
+  std::size_t counted = 0, code_points = 0;  // code points in line[0, counted)
   while (true) {
     while (i < line.size() && IsBlank(line[i])) ++i;
-    if (i >= line.size()) return true;
-    Field field;
-    field.start = CodePoints(line, i);
+    if (i >= line.size()) {
+      fields.resize(count);
+      return true;
+    }
+    Field& field = NextField(fields, count);
+    for (; counted < i; ++counted) code_points += IsContinuationByte(line[counted]) ? 0 : 1;
+    field.start = code_points;
     const std::size_t begin = i;
     if (line[i] == '"') {
       field.quoted = true;
@@ -220,6 +244,7 @@ bool SplitWhitespace(const Lines& lines, std::uint32_t number, std::vector<Field
       while (true) {
         if (i >= line.size()) {
           diags.Report(DiagKind::CsvUnclosedQuote, lines.Range(number, begin, 1));
+          fields.resize(count);
           return false;
         }
         if (line[i] == '"') {
@@ -235,15 +260,15 @@ bool SplitWhitespace(const Lines& lines, std::uint32_t number, std::vector<Field
       }
       if (i < line.size() && !IsBlank(line[i])) {
         diags.Report(DiagKind::CsvStrayQuote, lines.Range(number, i, 1), "text after the closing quote of a field");
+        fields.resize(count);
         return false;
       }
-      field.text = std::string(Trim(field.text));
+      TrimInPlace(field.text);
     } else {
       while (i < line.size() && !IsBlank(line[i])) ++i;
-      field.text = std::string(line.substr(begin, i - begin));
+      field.text.assign(line.substr(begin, i - begin));
     }
     field.range = lines.Range(number, begin, i - begin);
-    fields.push_back(std::move(field));
   }
 }
 
@@ -427,7 +452,21 @@ std::string Printable(std::string_view text) {
 }
 
 bool GlobMatch(std::string_view pattern, std::string_view text) {
-  // Iterative matcher with one backtrack point per '*' (linear in practice).
+  // The common shapes first: "PREFIX*" and "*PART*" (every row of a large
+  // list meets the default exclusions).
+  auto same = [](char a, char b) { return LowerAscii(a) == LowerAscii(b); };
+  if (pattern.find('?') == std::string_view::npos) {
+    std::size_t stars = std::count(pattern.begin(), pattern.end(), '*');
+    if (stars == 1 && pattern.back() == '*') {
+      std::string_view prefix = pattern.substr(0, pattern.size() - 1);
+      return text.size() >= prefix.size() && std::equal(prefix.begin(), prefix.end(), text.begin(), same);
+    }
+    if (stars == 2 && pattern.size() >= 2 && pattern.front() == '*' && pattern.back() == '*') {
+      std::string_view part = pattern.substr(1, pattern.size() - 2);
+      return std::search(text.begin(), text.end(), part.begin(), part.end(), same) != text.end();
+    }
+  }
+  // Otherwise an iterative matcher with one backtrack point per '*'.
   std::size_t p = 0, t = 0, star = std::string_view::npos, mark = 0;
   auto step = [&](std::size_t i) {  // the length of the code point at text[i]
     std::size_t n = Utf8Length(text, i);

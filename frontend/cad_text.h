@@ -47,7 +47,7 @@ class Lines {
 struct Field {
   std::string text;
   SourceRange range;      // the field as written, quotes included
-  std::size_t start = 0;  // its first character, in code points from the line start (fixed-width columns)
+  std::size_t start = 0;  // blank-separated fields: the first character's column in code points (fixed width)
   bool quoted = false;
 };
 

@@ -46,6 +46,11 @@ bool IsKeyword(std::string_view name) {
 // Text for a comment: one line, no control characters, valid UTF-8, no
 // trailing blanks (the canonical form drops them).
 std::string CommentText(std::string_view text) {
+  if (std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; })) {
+    std::string out(text);  // the common case: printable ASCII
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    return out;
+  }
   std::string out = cad::Printable(text);
   // Printable shows control bytes as \xNN; a tab or line end in a value
   // reads better as a space.
@@ -123,22 +128,94 @@ ir::ExprPtr IntLit(SourceLoc loc, int value) {
   return expr;
 }
 
-// Unique names in the program's one namespace (case-insensitive), with
-// what each name is for messages about collisions.
+// What a name in the program is, described only when a collision is
+// reported (building a sentence per part would dominate a large import).
+struct NameOwner {
+  std::string_view what;  // "the fixture", "the pick point of feeder", "the point of"
+  std::string_view name;  // the feeder or designator (empty for the others)
+  std::uint32_t line = 0;  // the part's line
+  std::string Describe() const {
+    if (name.empty()) return std::string(what);
+    std::string text = fmt::format("{} '{}'", what, cad::Printable(name));
+    if (line != 0) text += fmt::format(" (line {})", line);
+    return text;
+  }
+};
+
+// Unique names in the program's one namespace (case-insensitive). An open-
+// addressing table over the names as written: a large import makes one name
+// per part and board, and a node-based map's allocation per name would cost
+// more than the rest of building the program.
 class NameTable {
  public:
-  bool Taken(std::string_view name) const { return owners_.count(Lower(name)) != 0; }
-  const std::string& Owner(std::string_view name) const { return owners_.at(Lower(name)); }
-  // `wanted` if free, else wanted_2, wanted_3, ...
-  std::string Claim(const std::string& wanted, std::string owner) {
-    std::string name = wanted;
-    for (int k = 2; Taken(name); ++k) name = fmt::format("{}_{}", wanted, k);
-    owners_.emplace(Lower(name), std::move(owner));
-    return name;
+  explicit NameTable(std::size_t expected) {
+    std::size_t slots = 64;
+    while (slots < 2 * expected) slots *= 2;
+    slots_.assign(slots, kEmpty);
+    entries_.reserve(expected);
+  }
+
+  // `wanted` if free, else wanted_2, wanted_3, ...; `taken_by` tells who
+  // had `wanted`.
+  std::string Claim(const std::string& wanted, NameOwner owner, std::optional<NameOwner>* taken_by = nullptr) {
+    if (const NameOwner* existing = Insert(wanted, owner)) {
+      if (taken_by != nullptr) *taken_by = *existing;
+      for (int k = 2;; ++k) {
+        std::string name = fmt::format("{}_{}", wanted, k);
+        if (Insert(name, owner) == nullptr) return name;
+      }
+    }
+    return wanted;
   }
 
  private:
-  std::unordered_map<std::string, std::string> owners_;
+  static constexpr std::uint32_t kEmpty = 0xffffffff;
+  struct Entry {
+    std::string name;
+    NameOwner owner;
+  };
+
+  static char Lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+  static std::size_t Hash(std::string_view name) {
+    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
+    for (char c : name) hash = (hash ^ static_cast<unsigned char>(Lower(c))) * 1099511628211ull;
+    return static_cast<std::size_t>(hash);
+  }
+  static bool Same(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (Lower(a[i]) != Lower(b[i])) return false;
+    }
+    return true;
+  }
+
+  // Adds `name`, or returns the owner that already has it.
+  const NameOwner* Insert(const std::string& name, const NameOwner& owner) {
+    if (2 * (entries_.size() + 1) > slots_.size()) Grow();
+    std::size_t mask = slots_.size() - 1;
+    for (std::size_t slot = Hash(name) & mask;; slot = (slot + 1) & mask) {
+      if (slots_[slot] == kEmpty) {
+        slots_[slot] = static_cast<std::uint32_t>(entries_.size());
+        entries_.push_back({name, owner});
+        return nullptr;
+      }
+      const Entry& entry = entries_[slots_[slot]];
+      if (Same(entry.name, name)) return &entry.owner;
+    }
+  }
+
+  void Grow() {
+    slots_.assign(slots_.size() * 2, kEmpty);
+    std::size_t mask = slots_.size() - 1;
+    for (std::uint32_t e = 0; e < entries_.size(); ++e) {
+      std::size_t slot = Hash(entries_[e].name) & mask;
+      while (slots_[slot] != kEmpty) slot = (slot + 1) & mask;
+      slots_[slot] = e;
+    }
+  }
+
+  std::vector<std::uint32_t> slots_;
+  std::vector<Entry> entries_;
 };
 
 // 'text' for a message, or "none" when the list gives none.
@@ -211,10 +288,11 @@ CadImporter::CadImporter(const cad::FeederTable& feeders, ImportOptions options,
   summary_.boards = static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows);
 }
 
-bool CadImporter::Classify(const cad::Row& row, Part& part) const {
+bool CadImporter::Classify(const cad::Row& row, Part& part) {
   if (!options_.keep_dnp && (row.dnp || IsDnpValue(row.value))) {
     part.skip = SkipReason::kDnp;
-    part.skip_detail[0] = row.dnp ? "the DNP column" : fmt::format("its value '{}'", cad::Printable(row.value));
+    part.skip_detail = static_cast<int>(skip_details_.size());
+    skip_details_.push_back({row.dnp ? "the DNP column" : fmt::format("its value '{}'", cad::Printable(row.value))});
     part.skip_range = row.dnp ? row.dnp_range : row.value_range;
     return true;
   }
@@ -223,7 +301,8 @@ bool CadImporter::Classify(const cad::Row& row, Part& part) const {
     for (const std::string& pattern : patterns) {
       if (!cad::GlobMatch(pattern, text)) continue;
       part.skip = SkipReason::kExcluded;
-      part.skip_detail = {std::string(field), cad::Printable(text), std::string(rule), cad::Printable(pattern)};
+      part.skip_detail = static_cast<int>(skip_details_.size());
+      skip_details_.push_back({std::string(field), cad::Printable(text), std::string(rule), cad::Printable(pattern)});
       part.skip_range = range;
       return true;
     }
@@ -241,13 +320,13 @@ bool CadImporter::Classify(const cad::Row& row, Part& part) const {
 
 std::optional<cad::FeederMatch> CadImporter::FindFeeder(const cad::Row& row) {
   if (feeders_.matches_designators()) return feeders_.Find(row);
-  std::string key = row.package;
-  key += '\0';
-  key += row.value;
-  auto it = feeder_cache_.find(key);
+  cache_key_.assign(row.package);
+  cache_key_ += '\0';
+  cache_key_ += row.value;
+  auto it = feeder_cache_.find(cache_key_);
   if (it != feeder_cache_.end()) return it->second;
   std::optional<cad::FeederMatch> match = feeders_.Find(row);
-  feeder_cache_.emplace(std::move(key), match);
+  feeder_cache_.emplace(cache_key_, match);
   return match;
 }
 
@@ -262,7 +341,7 @@ void CadImporter::Add(const cad::Row& row) {
   part.rotation_deg = row.rotation_deg;
   part.side = row.side;
   part.designator_range = row.designator_range;
-  part.skip_range = row.side_range;
+  part.side_range = row.side_range;
   if (!Classify(row, part)) part.feeder = FindFeeder(row);
   parts_.push_back(std::move(part));
 }
@@ -270,15 +349,15 @@ void CadImporter::Add(const cad::Row& row) {
 void CadImporter::ReportSkip(const Part& part, cad::Side placed_side) {
   std::string designator = cad::Printable(part.designator);
   if (part.side != placed_side) {
-    diags_.Report(DiagKind::ImportSkippedSide, part.skip_range, designator, cad::SideName(part.side),
+    diags_.Report(DiagKind::ImportSkippedSide, part.side_range, designator, cad::SideName(part.side),
                   cad::SideName(placed_side));
     ++summary_.skipped[static_cast<int>(SkipReason::kOtherSide)];
   } else if (part.skip == SkipReason::kDnp) {
-    diags_.Report(DiagKind::ImportSkippedDnp, part.skip_range, designator, part.skip_detail[0]);
+    diags_.Report(DiagKind::ImportSkippedDnp, part.skip_range, designator, skip_details_[part.skip_detail][0]);
     ++summary_.skipped[static_cast<int>(SkipReason::kDnp)];
   } else if (part.skip == SkipReason::kExcluded) {
-    diags_.Report(DiagKind::ImportExcluded, part.skip_range, designator, part.skip_detail[0], part.skip_detail[1],
-                  part.skip_detail[2], part.skip_detail[3]);
+    const std::array<std::string, 4>& detail = skip_details_[part.skip_detail];
+    diags_.Report(DiagKind::ImportExcluded, part.skip_range, designator, detail[0], detail[1], detail[2], detail[3]);
     ++summary_.skipped[static_cast<int>(SkipReason::kExcluded)];
   } else {
     diags_.Report(DiagKind::ImportSkippedUnmapped, part.designator_range, designator, Quoted(part.package),
@@ -329,7 +408,7 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   cad::Side side = options_.side.value_or(on_side[1] > 0 && on_side[0] == 0 ? cad::Side::kBottom : cad::Side::kTop);
   if (!options_.side && on_side[0] > 0 && on_side[1] > 0) {
     int minority = on_side[1] <= on_side[0] ? 1 : 0;
-    diags_.Report(DiagKind::ImportMixedSides, first_on_side[minority]->skip_range, on_side[0], on_side[1]);
+    diags_.Report(DiagKind::ImportMixedSides, first_on_side[minority]->side_range, on_side[0], on_side[1]);
     summary_.failed = true;
     return std::nullopt;
   }
@@ -365,6 +444,7 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
     return std::nullopt;
   }
   std::optional<ir::Program> program = Build(placed, side);
+  std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
   if (!program || diags_.has_errors()) {
     summary_.failed = true;
     return std::nullopt;
@@ -375,9 +455,10 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
 std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side) {
   const SourceLoc start{list_file_, 1, 1};
   const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
-  NameTable names;
-  names.Claim(options_.fixture, "the fixture");
-  names.Claim("Main", "the function Main");
+  NameTable names(parts.size() * static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows) +
+                  2 * feeders.size() + 64);
+  names.Claim(options_.fixture, {"the fixture", {}, 0});
+  names.Claim("Main", {"the function Main", {}, 0});
 
   ir::Program program;
   program.file = list_file_;
@@ -405,7 +486,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       double dx = c * options_.pitch_x_mm, dy = r * options_.pitch_y_mm;
       double x = Round(options_.origin_x_mm + std::cos(angle) * dx - std::sin(angle) * dy, kCadResolutionMm);
       double y = Round(options_.origin_y_mm + std::sin(angle) * dx + std::cos(angle) * dy, kCadResolutionMm);
-      std::string name = names.Claim(panel ? fmt::format("Pcb{}", boards.size() + 1) : "Pcb", "a board frame");
+      std::string name = names.Claim(panel ? fmt::format("Pcb{}", boards.size() + 1) : "Pcb", {"a board frame", {}, 0});
       ir::LocalDecl local{name, start, MakeCoords(start, {x, y, 0.0, Round(options_.rotation_deg, kCadResolutionDeg)}),
                           options_.fixture, start};
       items.push_back(MakeStmt(start, std::move(local),
@@ -426,7 +507,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
     ++summary_.feeders_used;
     const cad::FeederSpec& feeder = feeders[f];
     SourceLoc loc = feeder.name_range.begin.known() ? feeder.name_range.begin : start;
-    std::string owner = fmt::format("the pick point of feeder '{}'", cad::Printable(feeder.name));
+    const NameOwner owner{"the pick point of feeder", feeder.name, 0};
     std::string comment = fmt::format(" feeder {}{}", CommentText(feeder.name), feeder.from_cell ? " (cell)" : "");
     if (first_feeder) items.push_back(CommentStmt(start, "The feeders' pick points (robot base frame)", true));
     first_feeder = false;
@@ -469,9 +550,11 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   std::string how = mirror == ImportMirror::kX   ? ", turned over: x negated"
                     : mirror == ImportMirror::kY ? ", turned over: y negated"
                                                  : "";
+  std::vector<std::string> comments;  // per part: " C1 100n C_0603"
+  comments.reserve(parts.size());
+  for (const Part* part : parts) comments.push_back(" " + PartComment(*part));
   // point_name[b][i]: the point of part i on board b.
   std::vector<std::vector<std::string>> point_name(boards.size(), std::vector<std::string>(parts.size()));
-  std::unordered_map<std::string, std::uint32_t> first_line;  // designator (any case) -> its line
   for (std::size_t b = 0; b < boards.size(); ++b) {
     items.push_back(CommentStmt(start,
                                 fmt::format("The parts on the {} side{}, in {} (board coordinates, mm)",
@@ -481,18 +564,17 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       const Part& part = *parts[i];
       const SourceLoc loc = part.designator_range.begin;
       const std::string wanted = panel ? boards[b] + "_" + MakeIdentifier(part.designator) : MakeIdentifier(part.designator);
-      const std::string owner = fmt::format("the point of '{}' (line {})", cad::Printable(part.designator), part.line);
-      const bool free = !names.Taken(wanted);
-      const std::string previous_owner = free ? std::string() : names.Owner(wanted);
-      const std::string name = names.Claim(wanted, owner);
-      if (b == 0) {
-        auto [seen, fresh] = first_line.emplace(Lower(part.designator), part.line);
-        if (!fresh) {
+      std::optional<NameOwner> taken;
+      const std::string name = names.Claim(wanted, {"the point of", part.designator, part.line}, &taken);
+      // Equal designators make equal names, so a duplicate shows as a
+      // collision with the point of the same designator.
+      if (b == 0 && taken) {
+        if (taken->what == "the point of" && Lower(taken->name) == Lower(part.designator)) {
           diags_.Report(DiagKind::ImportDuplicateDesignator, part.designator_range, cad::Printable(part.designator),
-                        seen->second, name);
-        } else if (!free) {
+                        taken->line, name);
+        } else {
           diags_.Report(DiagKind::ImportNameCollision, part.designator_range, cad::Printable(part.designator), wanted,
-                        fmt::format("that is {}", previous_owner), name);
+                        fmt::format("that is {}", taken->Describe()), name);
         }
       }
       point_name[b][i] = name;
@@ -503,7 +585,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       double u = NormaliseAngle(theta + part.feeder->rotation_offset_deg, options_.angles);
       ir::PointDecl point{name, loc, false,
                           MakeCoords(loc, {x == 0 ? 0.0 : x, y == 0 ? 0.0 : y, options_.place_z_mm, u}), boards[b], loc};
-      items.push_back(MakeStmt(loc, std::move(point), " " + PartComment(part)));
+      items.push_back(MakeStmt(loc, std::move(point), comments[i]));
     }
   }
 
@@ -549,7 +631,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         place.kind = ir::PickPlaceKind::Place;
         place.target.loc = loc;
         place.target.base = ir::NamedPoint{point_name[b][i], static_cast<std::uint32_t>(point_name[b][i].size())};
-        cycle.body.push_back(MakeStmt(loc, std::move(place), " " + PartComment(*part)));
+        cycle.body.push_back(MakeStmt(loc, std::move(place), comments[i]));
       }
     }
   }

@@ -119,12 +119,13 @@ class CadImporter {
     // A skip that does not depend on the side (DNP, excluded), with what the
     // warning says about it.
     std::optional<SkipReason> skip;
-    std::array<std::string, 4> skip_detail;
+    int skip_detail = -1;  // index into skip_details_
     SourceRange designator_range;
+    SourceRange side_range;
     SourceRange skip_range;
   };
 
-  bool Classify(const cad::Row& row, Part& part) const;
+  bool Classify(const cad::Row& row, Part& part);
   std::optional<cad::FeederMatch> FindFeeder(const cad::Row& row);
   void ReportSkip(const Part& part, cad::Side placed_side);
   void ReportUnmapped(const std::vector<const Part*>& unmapped);
@@ -137,6 +138,8 @@ class CadImporter {
   std::vector<Part> parts_;  // every row read cleanly, in list order
   // Feeder lookups by package and value, when no [[map]] looks at designators.
   std::unordered_map<std::string, std::optional<cad::FeederMatch>> feeder_cache_;
+  std::string cache_key_;
+  std::vector<std::array<std::string, 4>> skip_details_;  // what the skip warnings say
   ImportSummary summary_;
 };
 

@@ -76,10 +76,7 @@ double CompileState::SensorShareAt(const cell::Fixture& fixture, const Eigen::Ve
 }
 
 const cell::Region* RegionAt(const cell::Cell& cell, double x_mm, double y_mm) {
-  for (const cell::Region& region : cell.regions) {
-    if (region.x_mm.Contains(x_mm) && region.y_mm.Contains(y_mm)) return &region;
-  }
-  return nullptr;
+  return cell.RegionAt(Eigen::Vector2d(x_mm, y_mm));
 }
 
 }  // namespace smtcal

@@ -277,16 +277,32 @@ std::optional<FixEstimate> EstimateFix(const cell::Fixture& fixture, const std::
   return estimate;
 }
 
-Eigen::Vector2d DirectCalibrateInCell(const std::vector<cell::Region>& regions, const Eigen::Vector2d& commanded,
-                                      int* region) {
-  for (std::size_t r = 0; r < regions.size(); ++r) {
-    CalibrationMap map(regions[r].table);
-    if (!map.Inside(commanded)) continue;
+namespace {
+
+// Through the first map whose domain holds the point; unchanged when none does.
+Eigen::Vector2d DirectCalibrateThrough(const std::vector<CalibrationMap>& maps, const Eigen::Vector2d& commanded,
+                                       int* region) {
+  for (std::size_t r = 0; r < maps.size(); ++r) {
+    if (!maps[r].Inside(commanded)) continue;
     if (region != nullptr) *region = static_cast<int>(r);
-    return DirectCalibrate(map, commanded, OutsidePolicy::kClamp).point;
+    return DirectCalibrate(maps[r], commanded, OutsidePolicy::kClamp).point;
   }
   if (region != nullptr) *region = -1;
   return commanded;
+}
+
+std::vector<CalibrationMap> MapsOf(const std::vector<cell::Region>& regions) {
+  std::vector<CalibrationMap> maps;
+  maps.reserve(regions.size());
+  for (const cell::Region& region : regions) maps.emplace_back(region.table);
+  return maps;
+}
+
+}  // namespace
+
+Eigen::Vector2d DirectCalibrateInCell(const std::vector<cell::Region>& regions, const Eigen::Vector2d& commanded,
+                                      int* region) {
+  return DirectCalibrateThrough(MapsOf(regions), commanded, region);
 }
 
 const CheckResult& ScanResult::Check(ScanCheck check) const {
@@ -382,10 +398,10 @@ ScanResult ScanFixture(const cell::Fixture& fixture, const std::vector<std::opti
   if (!result.checks[1].passed) return result;
 
   // Where the sensor really was, then the estimator.
+  const std::vector<CalibrationMap> maps =
+      options.regions != nullptr ? MapsOf(*options.regions) : std::vector<CalibrationMap>();
   for (std::size_t k = 0; k < count; ++k) {
-    result.calibrated[k] = options.regions != nullptr
-                               ? DirectCalibrateInCell(*options.regions, *trips[k], &result.region[k])
-                               : *trips[k];
+    result.calibrated[k] = DirectCalibrateThrough(maps, *trips[k], &result.region[k]);
   }
   std::string why;
   result.estimate = EstimateFix(fixture, result.expected, result.calibrated, options.estimator, &why);
@@ -418,7 +434,8 @@ std::string DescribeCheck(const CheckResult& check, const cell::Fixture& fixture
     case ScanCheck::kMissingTrip:
       return fmt::format("trip {} is missing{}: the sensor did not trip where the scan path crosses that edge",
                          trip_edge(check.trip),
-                         check.value > 1 ? fmt::format(" ({} trips are missing)", static_cast<int>(check.value)) : std::string());
+                         check.value > 1 ? fmt::format(" ({} trips are missing)", static_cast<int>(check.value))
+                                         : std::string());
     case ScanCheck::kTripWindow:
       return fmt::format("trip {} is {:.3f} mm from where the nominal pose puts it, more than trip_window_mm = {}",
                          trip_edge(check.trip), check.value, FormatMm(check.limit));

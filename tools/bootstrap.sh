@@ -17,4 +17,12 @@ head -n 20 build/layers.fmt.place
 build/smtcal fmt --check "$example/layers.place" && echo "(the example is already in canonical form)"
 echo "== smtcal table stats $example/placing-table.csv"
 build/smtcal table stats "$example/placing-table.csv"
+echo "== smtcal cell check $example/paper.cell.toml"
+build/smtcal cell check "$example/paper.cell.toml"
+echo "== smtcal verify $example/layers.place --cell $example/paper.cell.toml"
+build/smtcal verify "$example/layers.place" --cell "$example/paper.cell.toml"
+echo "== smtcal compile $example/layers.place --cell $example/paper.cell.toml -o build/layers.corrected.place"
+build/smtcal compile "$example/layers.place" --cell "$example/paper.cell.toml" \
+  -o build/layers.corrected.place --report build/layers.report.json
+diff "$example/layers.place" build/layers.corrected.place | head -n 30 || true
 echo "bootstrap: done; smtcal is build/smtcal"

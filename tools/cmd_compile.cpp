@@ -3,7 +3,7 @@
 // program, verify only reports.
 #include <fmt/core.h>
 
-// WIP #include "backend/c_data.h"
+#include "backend/c_data.h"
 #include "backend/compile_report.h"
 #include "backend/place_printer.h"
 #include "frontend/cell.h"
@@ -91,12 +91,11 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
                        std::make_move_iterator(header.end()));
 }
 
-#if 0  // WIP
 std::vector<CRuntimePoint> FixturePoints(const CompileState& state) {
   std::vector<CRuntimePoint> points;
   for (const Target& target : state.targets) {
     if (target.kind != CorrectionKind::kFixture || !target.known) continue;
-    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].name,
+    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].cell_fixture->name,
                                    Eigen::Vector2d(target.in_frame[0], target.in_frame[1]), target.in_frame[2],
                                    target.in_frame[3], target.stmt->loc});
   }
@@ -109,7 +108,6 @@ std::string ProgramName(const ir::Program& program) {
   }
   return "program";
 }
-#endif
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   SourceManager sources;
@@ -121,7 +119,14 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   const CompileState& state = *compiled.program.compile;
   std::string text;
   if (opt.target == "c") {
-    // WIP text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
+    for (const cell::Fixture& fixture : compiled.cell->fixtures) {
+      if (FitsCRuntime(fixture)) continue;
+      fmt::print(stderr, "smtcal: error: the scan paths of fixture '{}' make more trips than the C runtime holds ({}, "
+                         "SMTCAL_MAX_TRIPS in runtime/c/smtcal_runtime.h)\n", fixture.name, kCRuntimeMaxTrips);
+      options.exit_code = kExitInputError;
+      return;
+    }
+    text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
   } else {
     AddHeader(compiled.program, *compiled.cell);
     text = PrintPlace(compiled.program);

@@ -95,10 +95,10 @@ std::optional<std::array<int, 2>> ParsePanel(const std::string& text) {
 }
 
 std::optional<char> ParseDelimiter(const std::string& text) {
-  if (text == "," || text == "comma") return ',';
-  if (text == ";" || text == "semicolon") return ';';
-  if (text == "\t" || text == "tab") return '\t';
-  if (text == " " || text == "space" || text == "blank") return ' ';
+  if (text == "comma") return ',';
+  if (text == "semicolon") return ';';
+  if (text == "tab") return '\t';
+  if (text == "space") return ' ';
   return std::nullopt;
 }
 
@@ -277,7 +277,7 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
       ->check(CLI::IsMember({"mm", "mil", "in"}));
   cmd->add_option("--delimiter", opt.delimiter, "field separator: comma, semicolon, tab or space (default: from the "
                                                 "header line)")
-      ->check(CLI::IsMember({",", ";", "comma", "semicolon", "tab", "space"}));
+      ->check(CLI::IsMember({"comma", "semicolon", "tab", "space"}));
 
   // Which parts.
   cmd->add_option("--side", opt.side,

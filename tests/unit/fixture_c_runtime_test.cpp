@@ -338,8 +338,8 @@ int main(void) {{
   for (i = 0; i < program->point_count; ++i) {{
     if (program->points[i].fixture > 0) continue;
     smtcal_program_point(program, &scan.fix, i, &out);
-    printf("%s %d %s %.17g %.17g %.17g %.17g\n", program->points[i].name, out.region, smtcal_point_status_name(out.status),
-           out.command[0], out.command[1], out.z, out.u_deg);
+    printf("%s %d %s %.17g %.17g %.17g %.17g\n", program->points[i].name, out.region,
+           smtcal_point_status_name(out.status), out.command[0], out.command[1], out.z, out.u_deg);
   }}
   printf("%s\n", program->fixtures[1].name);
   return 0;
@@ -347,8 +347,8 @@ int main(void) {{
 )",
                                                trip_list);
   const std::string runtime = fs::path(SMTCAL_SOURCE_DIR) / "runtime" / "c";
-  const Command built =
-      RunShell(fmt::format("{} -I'{}' '{}/smtcal_runtime.c' data.c main.c -lm -o program", kStrictC, runtime, runtime), dir);
+  const Command built = RunShell(
+      fmt::format("{} -I'{}' '{}/smtcal_runtime.c' data.c main.c -lm -o program", kStrictC, runtime, runtime), dir);
   ASSERT_EQ(built.exit_code, 0) << built.out;
   const Command ran = RunShell("./program", dir);
   ASSERT_EQ(ran.exit_code, 0) << ran.out;

@@ -121,7 +121,8 @@ inline ErrorTable RandomSmoothTable(std::mt19937_64& rng, double x0, double y0, 
                                     double amplitude) {
   ErrorTable table;
   table.name = "random";
-  const double kx = Uniform(rng, 0.5, 2) * 2 * std::numbers::pi / w, ky = Uniform(rng, 0.5, 2) * 2 * std::numbers::pi / h;
+  const double kx = Uniform(rng, 0.5, 2) * 2 * std::numbers::pi / w;
+  const double ky = Uniform(rng, 0.5, 2) * 2 * std::numbers::pi / h;
   const double phase = Uniform(rng, 0, 6.28), tilt = Uniform(rng, -1, 1) * amplitude / w;
   for (TableAxis axis : kTableAxes) {
     AxisTable& t = table[axis];
