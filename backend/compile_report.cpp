@@ -11,8 +11,6 @@
 
 namespace smtcal {
 
-std::string_view TargetKeyword(const ir::Stmt& stmt);  // passes/regions.cpp
-
 namespace {
 
 using nlohmann::json;
@@ -22,8 +20,8 @@ json PoseJson(const Pose4& pose) {
 }
 
 json FixJson(const Eigen::Affine3d& fix) {
-  double angle = std::atan2(fix.linear()(1, 0), fix.linear()(0, 0)) * 180.0 / std::numbers::pi;
-  return json{{"x_mm", fix.translation().x()}, {"y_mm", fix.translation().y()}, {"angle_deg", angle}};
+  std::array<double, 4> pose = PoseValues(fix);
+  return json{{"x_mm", pose[0]}, {"y_mm", pose[1]}, {"angle_deg", pose[3]}};
 }
 
 std::string FixtureName(const CompileState& state, int fixture) {

@@ -33,7 +33,9 @@ std::string Parenthesized(const ir::Expr& expr, bool parenthesize) {
   return parenthesize ? "(" + text + ")" : text;
 }
 
-std::string CoordsText(const ir::Coords& coords) {
+}  // namespace
+
+std::string PrintCoords(const ir::Coords& coords) {
   std::string text = "XY(";
   for (std::size_t i = 0; i < coords.values.size(); ++i) {
     if (i > 0) text += ", ";
@@ -41,6 +43,8 @@ std::string CoordsText(const ir::Coords& coords) {
   }
   return text + ")";
 }
+
+namespace {
 
 class Printer {
  public:
@@ -94,14 +98,14 @@ class Printer {
           } else if constexpr (std::is_same_v<Node, ir::FixtureDecl>) {
             Line(depth, "Fixture " + node.name, comment);
           } else if constexpr (std::is_same_v<Node, ir::LocalDecl>) {
-            std::string text = "Local " + node.name + " = " + CoordsText(node.origin);
+            std::string text = "Local " + node.name + " = " + PrintCoords(node.origin);
             if (!node.frame.empty()) text += " In " + node.frame;
             Line(depth, text, comment);
           } else if constexpr (std::is_same_v<Node, ir::PointDecl>) {
             // The IR does not say whether In or On was written: a programmed
             // point is given In a frame, a taught point was taught On a fixture.
             std::string text = std::string(node.taught ? "Taught Point " : "Point ") + node.name +
-                               " = " + CoordsText(node.coords);
+                               " = " + PrintCoords(node.coords);
             if (!node.frame.empty()) text += (node.taught ? " On " : " In ") + node.frame;
             Line(depth, text, comment);
           } else if constexpr (std::is_same_v<Node, ir::PalletDecl>) {
@@ -270,7 +274,7 @@ std::string PrintPointExpr(const ir::PointExpr& point) {
         if constexpr (std::is_same_v<Base, ir::NamedPoint>) {
           return base.name;
         } else if constexpr (std::is_same_v<Base, ir::Coords>) {
-          return CoordsText(base);
+          return PrintCoords(base);
         } else if constexpr (std::is_same_v<Base, ir::PalletPoint>) {
           SMTCAL_CHECK(base.number != nullptr && base.i != nullptr, "Pallet() without its indexes");
           std::string pallet = "Pallet(" + PrintExpr(*base.number) + ", " + PrintExpr(*base.i);

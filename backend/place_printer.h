@@ -27,6 +27,8 @@ std::string PrintExpr(const ir::Expr& expr);
 
 // A point expression: `P1 + X(d)`, `XY(...)`, `Pallet(n, i, j) - Z(h)`.
 std::string PrintPointExpr(const ir::PointExpr& point);
+// XY(x, y, z, u) as the canonical form writes it.
+std::string PrintCoords(const ir::Coords& coords);
 
 // Number literals. A real literal is its shortest round-trip decimal and
 // always has a '.' (12.70 -> "12.7", -12 -> "-12.0"); magnitudes outside

@@ -67,7 +67,7 @@ class Bind final : public Pass {
     binding.name = decl.name;
     binding.decl = &stmt;
     binding.cell_fixture = fixture;
-    binding.nominal = PlanarPose(fixture->origin_mm.x(), fixture->origin_mm.y(), fixture->angle_deg);
+    binding.nominal = PoseMatrix(fixture->origin_mm.x(), fixture->origin_mm.y(), 0, fixture->angle_deg);
     if (!fixture->teach_trips_mm.empty()) {
       TeachPose pose = EstimateTeachPose(*fixture, cell);
       if (pose.fix) binding.fix0 = *pose.fix;

@@ -2,7 +2,6 @@
 #include "passes/compile_state.h"
 
 #include <cmath>
-#include <numbers>
 
 #include "passes/symbols.h"
 
@@ -37,30 +36,14 @@ const InverseSolver& CompileState::SolverFor(const cell::Region& region) {
   return *solver;
 }
 
-Eigen::Affine3d PlanarPose(double x_mm, double y_mm, double angle_deg) {
-  Eigen::Affine3d pose = Eigen::Affine3d::Identity();
-  pose.rotate(Eigen::AngleAxisd(angle_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()));
-  pose.pretranslate(Eigen::Vector3d(x_mm, y_mm, 0));
-  return pose;
-}
-
-namespace {
-
-// The rotation of FIX about the base z axis, in degrees.
-double AngleDeg(const Eigen::Affine3d& fix) {
-  return std::atan2(fix.linear()(1, 0), fix.linear()(0, 0)) * 180.0 / std::numbers::pi;
-}
-
-}  // namespace
-
 Pose4 PoseToBase(const Eigen::Affine3d& fix, const Pose4& in_fixture) {
   Eigen::Vector3d p = fix * Eigen::Vector3d(in_fixture[0], in_fixture[1], in_fixture[2]);
-  return {p.x(), p.y(), p.z(), in_fixture[3] + AngleDeg(fix)};
+  return {p.x(), p.y(), p.z(), in_fixture[3] + PoseValues(fix)[3]};
 }
 
 Pose4 PoseToFixture(const Eigen::Affine3d& fix, const Pose4& in_base) {
   Eigen::Vector3d p = fix.inverse() * Eigen::Vector3d(in_base[0], in_base[1], in_base[2]);
-  return {p.x(), p.y(), p.z(), in_base[3] - AngleDeg(fix)};
+  return {p.x(), p.y(), p.z(), in_base[3] - PoseValues(fix)[3]};
 }
 
 TeachPose EstimateTeachPose(const cell::Fixture& fixture, const cell::Cell& cell) {
@@ -75,9 +58,19 @@ double CompileState::SensorShareAt(const cell::Fixture& fixture, const Eigen::Ve
   return share->AtMm(point_in_fixture);
 }
 
-const cell::Region* RegionAt(const cell::Cell& cell, double x_mm, double y_mm) {
-  return cell.RegionAt(Eigen::Vector2d(x_mm, y_mm));
+std::string_view TargetKeyword(const ir::Stmt& stmt) {
+  if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
+    return pick->kind == ir::PickPlaceKind::Pick ? "Pick" : "Place";
+  }
+  switch (std::get<ir::Motion>(stmt.node).kind) {
+    case ir::MotionKind::Jump: return "Jump";
+    case ir::MotionKind::Go: return "Go";
+    case ir::MotionKind::Move: return "Move";
+  }
+  return "?";
 }
+
+double RoundForProgramText(double value) { return std::round(value * 1e10) / 1e10; }
 
 }  // namespace smtcal
 

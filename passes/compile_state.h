@@ -137,9 +137,13 @@ struct CompileState {
 Pose4 PoseToBase(const Eigen::Affine3d& fix, const Pose4& in_fixture);
 // The fixture-frame pose of a base-frame pose (FIX^-1).
 Pose4 PoseToFixture(const Eigen::Affine3d& fix, const Pose4& in_base);
-// FIX for a planar pose: origin (x, y) mm and angle of its x axis in degrees.
-Eigen::Affine3d PlanarPose(double x_mm, double y_mm, double angle_deg);
-// The region whose bounds hold (x, y); null when none does.
-const cell::Region* RegionAt(const cell::Cell& cell, double x_mm, double y_mm);
+// "Pick", "Place", "Jump", "Go" or "Move": a target statement's keyword, for messages.
+std::string_view TargetKeyword(const ir::Stmt& stmt);
+// Coordinates a pass writes into the corrected program are rounded to 1e-10
+// mm (degrees): shorter text, and far below kInverseResidualTolMm.
+double RoundForProgramText(double value);
+inline double Radians(double degrees) { return degrees * kRadPerDeg; }
+// x and y of a pose, for the 2-D calibration math.
+inline Eigen::Vector2d Xy(const Pose4& pose) { return {pose[0], pose[1]}; }
 
 }  // namespace smtcal

@@ -25,21 +25,9 @@
 namespace smtcal {
 namespace {
 
-Eigen::Vector2d Xy(const Pose4& pose) { return {pose[0], pose[1]}; }
-
-std::string CoordsText(const Pose4& pose) {
-  ir::PointExpr point;
-  ir::Coords coords;
-  coords.values = pose;
-  point.base = coords;
-  return PrintPointExpr(point);
-}
-
-// Rounded to 1e-10 mm (degrees) for the corrected program's text.
-Pose4 Rounded(const Pose4& pose) {
-  Pose4 out;
-  for (int a = 0; a < 4; ++a) out[a] = std::round(pose[a] * 1e10) / 1e10;
-  return out;
+Pose4 RoundedForProgramText(Pose4 pose) {
+  for (double& value : pose) value = RoundForProgramText(value);
+  return pose;
 }
 
 class FixtureCorrection final : public Pass {
@@ -60,7 +48,7 @@ class FixtureCorrection final : public Pass {
       TaughtPoint taught;
       taught.decl = item.get();
       taught.taught = decl->coords.values;
-      taught.region = RegionAt(cell, taught.taught[0], taught.taught[1]);
+      taught.region = cell.RegionAt(Xy(taught.taught));
       taught.reached = taught.taught;
       if (taught.region != nullptr) {
         Solution reached = DirectCalibrate(state.SolverFor(*taught.region).map(), Xy(taught.taught),
@@ -68,7 +56,7 @@ class FixtureCorrection final : public Pass {
         taught.reached[0] = reached.point.x();
         taught.reached[1] = reached.point.y();
       }
-      taught.fixpos0 = Rounded(PoseToFixture(*state.fixtures[fixture].fix0, taught.reached));
+      taught.fixpos0 = RoundedForProgramText(PoseToFixture(*state.fixtures[fixture].fix0, taught.reached));
       taught_index[item.get()] = state.taught.size();
       state.taught.push_back(taught);
     }
@@ -82,7 +70,7 @@ class FixtureCorrection final : public Pass {
         const TaughtPoint& taught = state.taught[it->second];
         for (int a = 0; a < 4; ++a) target.in_frame[a] = taught.fixpos0[a] + target.taught_offset[a];
         target.required = PoseToBase(binding.nominal, target.in_frame);
-        target.region = RegionAt(cell, target.required[0], target.required[1]);
+        target.region = cell.RegionAt(Xy(target.required));
       }
       target.sensor_share_mm = state.SensorShareAt(*binding.cell_fixture, Xy(target.in_frame));
       if (target.region == nullptr) continue;  // reported by regions
@@ -94,15 +82,15 @@ class FixtureCorrection final : public Pass {
       target.iteration_bound = solver.iteration_bound();
     }
 
-    for (const TaughtPoint& taught : state.taught) Lower(taught, cell);
+    for (const TaughtPoint& taught : state.taught) Lower(taught);
   }
 
  private:
   // The taught declaration becomes the off-line point it is equivalent to.
-  static void Lower(const TaughtPoint& taught, const cell::Cell& /*cell*/) {
+  static void Lower(const TaughtPoint& taught) {
     auto& stmt = const_cast<ir::Stmt&>(*taught.decl);  // the pass owns the IR it runs on
     auto& decl = std::get<ir::PointDecl>(stmt.node);
-    std::string note = fmt::format("taught {} On {}; FIXPOS_0 = FIX_0^-1 * F(taught){}", CoordsText(taught.taught), decl.frame,
+    std::string note = fmt::format("taught {} On {}; FIXPOS_0 = FIX_0^-1 * F(taught){}", PrintCoords({taught.taught, {}}), decl.frame,
                                    taught.region != nullptr ? ", F of region " + taught.region->name : "");
     decl.taught = false;
     decl.coords.values = taught.fixpos0;

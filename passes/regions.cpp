@@ -24,19 +24,6 @@
 
 namespace smtcal {
 
-// "Pick", "Place", "Jump", ...: the statement's keyword, for messages.
-std::string_view TargetKeyword(const ir::Stmt& stmt) {
-  if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
-    return pick->kind == ir::PickPlaceKind::Pick ? "Pick" : "Place";
-  }
-  switch (std::get<ir::Motion>(stmt.node).kind) {
-    case ir::MotionKind::Jump: return "Jump";
-    case ir::MotionKind::Go: return "Go";
-    case ir::MotionKind::Move: return "Move";
-  }
-  return "?";
-}
-
 namespace {
 
 std::string RegionList(const cell::Cell& cell) {
@@ -79,7 +66,7 @@ class Regions final : public Pass {
         continue;
       }
       target.required = RequiredPosition(target, state);
-      target.region = RegionAt(cell, target.required[0], target.required[1]);
+      target.region = cell.RegionAt(Xy(target.required));
       if (target.region != nullptr) continue;
       std::string x = FormatMm(target.required[0]), y = FormatMm(target.required[1]);
       if (std::holds_alternative<ir::PickPlace>(target.stmt->node)) {

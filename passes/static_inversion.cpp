@@ -10,7 +10,6 @@
 // XY(...), the required position kept in the statement's comment, so the
 // corrected program commands the robot directly. Run-time targets keep their
 // text; the controller corrects them.
-#include <cmath>
 #include <memory>
 
 #include <fmt/format.h>
@@ -22,25 +21,12 @@
 
 namespace smtcal {
 
-std::string_view TargetKeyword(const ir::Stmt& stmt);  // passes/regions.cpp
-
 namespace {
-
-// v rounded to 1e-10 (the nearest double to it).
-double RoundToTenths(double v) { return std::round(v * 1e10) / 1e10; }
 
 ir::PointExpr* TargetOf(ir::Stmt& stmt) {
   if (auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) return &pick->target;
   if (auto* motion = std::get_if<ir::Motion>(&stmt.node)) return &motion->target;
   return nullptr;
-}
-
-std::string CoordsText(const Pose4& pose) {
-  ir::PointExpr point;
-  ir::Coords coords;
-  coords.values = pose;
-  point.base = coords;
-  return PrintPointExpr(point);
 }
 
 class StaticInversion final : public Pass {
@@ -54,15 +40,14 @@ class StaticInversion final : public Pass {
       bool base = target.kind == CorrectionKind::kStatic || target.kind == CorrectionKind::kRunTimeBase;
       if (!base || !target.known || target.region == nullptr) continue;
       const InverseSolver& solver = state.SolverFor(*target.region);
-      Solution solution = solver.Solve({target.required[0], target.required[1]}, target.region->outside);
-      // Commands are written with 10 decimals (0.1 nm): shorter text, and the
-      // residual, recomputed for the rounded command, stays far below 1e-9 mm.
-      Eigen::Vector2d command(RoundToTenths(solution.point.x()), RoundToTenths(solution.point.y()));
+      Solution solution = solver.Solve(Xy(target.required), target.region->outside);
+      // The residual is recomputed for the command as the program writes it.
+      Eigen::Vector2d command(RoundForProgramText(solution.point.x()), RoundForProgramText(solution.point.y()));
       target.nominal = {command.x(), command.y(), target.required[2], target.required[3]};
       target.residual_mm = solution.residual_mm;
       if (solution.status == SolveStatus::kOk) {
         Solution reached = DirectCalibrate(solver.map(), command, target.region->outside);
-        target.residual_mm = (reached.point - Eigen::Vector2d(target.required[0], target.required[1])).norm();
+        target.residual_mm = (reached.point - Xy(target.required)).norm();
       }
       target.iterations = solution.iterations;
       target.iteration_bound = solver.iteration_bound();
@@ -92,7 +77,7 @@ class StaticInversion final : public Pass {
     point->base = coords;
     point->offsets.clear();
     std::string note = fmt::format("required {} = {}, region {}, residual {} mm", target.text,
-                                   CoordsText(target.required), target.region->name,
+                                   PrintCoords({target.required, {}}), target.region->name,
                                    fmt::format("{:.1e}", target.residual_mm));
     stmt.trailing_comment = stmt.trailing_comment.empty() ? " " + note : stmt.trailing_comment + "; " + note;
   }

@@ -21,8 +21,6 @@ namespace {
 using Value = std::optional<double>;  // nullopt: known only at run time
 using Variables = std::map<std::string, Value>;
 
-double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
-
 int AxisIndex(ir::Axis axis) {
   switch (axis) {
     case ir::Axis::X: return 0;
@@ -230,9 +228,7 @@ class Tracer {
       target.known = false;
       target.unknown_because = unknown->because;
       // The frame is still known: the point's declaration decides it.
-      const ir::Stmt* ignored = nullptr;
-      Frame probe = frame;
-      target.fixture = state_.FindFixture(FrameRootOf(point, probe, ignored));
+      target.fixture = state_.FindFixture(FrameRootOf(point, frame));
     } else {
       const RootedPose& rooted = std::get<RootedPose>(position);
       target.fixture = rooted.fixture.empty() ? -1 : state_.FindFixture(rooted.fixture);
@@ -252,14 +248,10 @@ class Tracer {
   }
 
   // Whether the target hangs on a fixture (bound to the cell or not).
-  bool FixtureNamed(const ir::PointExpr& point, Frame& frame) {
-    const ir::Stmt* ignored = nullptr;
-    Frame probe = frame;
-    return !FrameRootOf(point, probe, ignored).empty();
-  }
+  bool FixtureNamed(const ir::PointExpr& point, Frame& frame) { return !FrameRootOf(point, frame).empty(); }
 
   // The root frame (fixture name or "") of a target whose position is unknown.
-  std::string FrameRootOf(const ir::PointExpr& point, Frame& frame, const ir::Stmt*& taught_decl) {
+  std::string FrameRootOf(const ir::PointExpr& point, Frame& frame) {
     std::string frame_name;
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
       const sema::Symbol* symbol = symbols_.Find(named->name);
@@ -272,10 +264,7 @@ class Tracer {
       const sema::SymbolTable::PalletEntry* entry = symbols_.FindPallet(static_cast<int>(*number));
       if (entry == nullptr) return "";
       const auto& corner = std::get<ir::PointDecl>(symbols_.Find(entry->pallet->corners[0])->decl->node);
-      if (corner.taught) {
-        taught_decl = symbols_.Find(entry->pallet->corners[0])->decl;
-        return corner.frame;
-      }
+      if (corner.taught) return corner.frame;
       frame_name = corner.frame;
     }
     return ResolveFrame(symbols_, frame_name, Pose4{}).fixture;

@@ -24,11 +24,7 @@
 
 namespace smtcal {
 
-std::string_view TargetKeyword(const ir::Stmt& stmt);  // passes/regions.cpp
-
 namespace {
-
-double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
 // Time to move `distance` with a trapezoidal profile (triangular when short).
 double MoveTime(double distance, double speed, double accel) {
