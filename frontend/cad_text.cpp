@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <fast_float/fast_float.h>
 #include <fmt/format.h>
 
 #include "passes/tolerances.h"
@@ -49,21 +48,6 @@ std::string_view Trim(std::string_view text) {
   return text;
 }
 
-// The length of the valid UTF-8 sequence at text[i], or 0 if there is none.
-std::size_t Utf8Length(std::string_view text, std::size_t i) {
-  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char lead = byte(i);
-  std::size_t length = lead < 0x80           ? 1
-                       : (lead >> 5) == 0x6   ? 2
-                       : (lead >> 4) == 0xe   ? 3
-                       : (lead >> 3) == 0x1e  ? 4
-                                              : 0;
-  if (length == 0 || i + length > text.size()) return 0;
-  for (std::size_t k = 1; k < length; ++k) {
-    if ((byte(i + k) & 0xc0) != 0x80) return 0;
-  }
-  return length;
-}
 
 double Round(double value, double resolution) {
   // Dividing by the exact integer 1/resolution gives the double nearest to
@@ -315,16 +299,6 @@ char GuessDelimiter(std::string_view line) {
 
 // ------------------------------------------------------------------ numbers
 
-std::optional<double> ParseNumber(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  if (text.empty() || text.front() == '+') return std::nullopt;
-  double value = 0;
-  auto [end, ec] = fast_float::from_chars(text.data(), text.data() + text.size(), value);
-  if (end != text.data() + text.size()) return std::nullopt;
-  if (ec == std::errc::result_out_of_range) return std::abs(value) < 1 ? 0.0 : HUGE_VAL;
-  if (ec != std::errc()) return std::nullopt;
-  return value;
-}
 
 namespace {
 
@@ -435,21 +409,6 @@ ColumnName NormaliseColumnName(std::string_view name) {
   return column;
 }
 
-std::string Printable(std::string_view text) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size();) {
-    auto byte = static_cast<unsigned char>(text[i]);
-    std::size_t length = Utf8Length(text, i);
-    if (length == 0 || byte < 0x20 || byte == 0x7f) {
-      out += fmt::format("\\x{:02x}", byte);
-      ++i;
-    } else {
-      out += text.substr(i, length);
-      i += length;
-    }
-  }
-  return out;
-}
 
 bool GlobMatch(std::string_view pattern, std::string_view text) {
   // The common shapes first: "PREFIX*" and "*PART*" (every row of a large

@@ -13,6 +13,7 @@
 
 #include "frontend/cad_row.h"
 #include "frontend/diagnostics.h"
+#include "frontend/field_text.h"
 #include "frontend/source.h"
 
 namespace smtcal::cad {
@@ -85,9 +86,6 @@ struct Length {
 Length ParseLength(std::string_view text, LengthUnit unit, bool decimal_comma);
 // An angle in degrees, optionally followed by "deg" or "°".
 std::optional<double> ParseAngle(std::string_view text, bool decimal_comma);
-// A plain decimal number (fast_float, no locale): nullopt when `text` is
-// not exactly one number.
-std::optional<double> ParseNumber(std::string_view text);
 // A unit name: mm, mil, mils, in, inch, inches (any case).
 std::optional<LengthUnit> UnitFromName(std::string_view name);
 
@@ -110,8 +108,6 @@ struct ColumnName {
 };
 ColumnName NormaliseColumnName(std::string_view name);
 
-// A field's text for a message: control characters and invalid UTF-8 as \xNN.
-std::string Printable(std::string_view text);
 
 // Case-insensitive glob match: '*' any run, '?' one code point; the rest
 // compared ASCII-case-insensitively.

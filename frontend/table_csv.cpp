@@ -4,15 +4,17 @@
 // out and reading goes on, so one run reports all of them.
 #include "frontend/table_csv.h"
 
+#include "frontend/field_text.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <string_view>
 
-#include <fast_float/fast_float.h>
 #include <fmt/format.h>
 
 #include "frontend/check.h"
+#include "frontend/field_text.h"
 #include "passes/tolerances.h"
 
 namespace smtcal {
@@ -26,40 +28,7 @@ std::string Lowercase(std::string_view text) {
   return lower;
 }
 
-// The length of the valid UTF-8 sequence at text[i], or 0 if there is none.
-std::size_t Utf8Length(std::string_view text, std::size_t i) {
-  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char lead = byte(i);
-  std::size_t length = lead < 0x80           ? 1
-                       : (lead >> 5) == 0x6   ? 2
-                       : (lead >> 4) == 0xe   ? 3
-                       : (lead >> 3) == 0x1e  ? 4
-                                              : 0;
-  if (length == 0 || i + length > text.size()) return 0;
-  for (std::size_t k = 1; k < length; ++k) {
-    if ((byte(i + k) & 0xc0) != 0x80) return 0;
-  }
-  return length;
-}
 
-// A field's text for a message: control characters and bytes that are not
-// UTF-8 shown as \xNN, so a binary file cannot garble the terminal, cut a
-// message short, or make the JSON output invalid.
-std::string Printable(std::string_view text) {
-  std::string out;
-  for (std::size_t i = 0; i < text.size();) {
-    auto byte = static_cast<unsigned char>(text[i]);
-    std::size_t length = Utf8Length(text, i);
-    if (length == 0 || byte < 0x20 || byte == 0x7f) {
-      out += fmt::format("\\x{:02x}", byte);
-      ++i;
-    } else {
-      out += text.substr(i, length);
-      i += length;
-    }
-  }
-  return out;
-}
 
 SourceLoc At(std::uint32_t file, std::uint32_t line, std::size_t offset) {
   return SourceLoc{file, line, static_cast<std::uint32_t>(offset + 1)};
@@ -155,20 +124,6 @@ std::string JoinColumns(const Schema& schema, std::size_t count, std::string_vie
   return text;
 }
 
-std::optional<double> ParseDouble(std::string_view text) {
-  if (!text.empty() && text.front() == '+') {
-    text.remove_prefix(1);
-    if (!text.empty() && (text.front() == '-' || text.front() == '+')) return std::nullopt;
-  }
-  if (text.empty()) return std::nullopt;
-  double value = 0;
-  auto [end, ec] = fast_float::from_chars(text.data(), text.data() + text.size(), value);
-  if (end != text.data() + text.size()) return std::nullopt;
-  if (ec != std::errc() && ec != std::errc::result_out_of_range) return std::nullopt;
-  if (ec == std::errc::result_out_of_range && std::abs(value) < 1) return 0.0;  // underflow
-  if (ec == std::errc::result_out_of_range) return HUGE_VAL;  // reported as not finite
-  return value;
-}
 
 // A header maps each of the schema's columns to a field index (or none).
 struct Header {
@@ -184,7 +139,7 @@ bool LooksLikeHeader(const CsvRecord& record, const Schema& schema) {
     for (std::string_view column : schema.columns) {
       if (name == column) return true;
     }
-    if (ParseDouble(field.text)) any_number = true;
+    if (ParseNumber(field.text)) any_number = true;
   }
   return !any_number;
 }
@@ -305,7 +260,7 @@ class Row {
     const CsvField* field = Field(column);
     if (optional_column && (field == nullptr || field->text.empty())) return std::nullopt;
     if (!Present(column, field)) return std::nullopt;
-    std::optional<double> value = ParseDouble(field->text);
+    std::optional<double> value = ParseNumber(field->text);
     if (!value) {
       diags_.Report(DiagKind::CsvBadNumber, field->range, Printable(field->text), schema_.columns[column],
                     NumberHint(field->text));

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <string>
 
-#include <fast_float/fast_float.h>
 #include <fmt/format.h>
 
+#include "frontend/field_text.h"
 #include "frontend/table_csv.h"
 #include "passes/tolerances.h"
 
@@ -31,28 +31,7 @@ std::string Lowercase(std::string_view text) {
   return lower;
 }
 
-// A field for a message: control characters and bytes above ASCII as \xNN,
-// so a binary file cannot garble the terminal or the JSON diagnostics.
-std::string Printable(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    out += byte < 0x20 || byte >= 0x7f ? fmt::format("\\x{:02x}", byte) : std::string(1, c);
-  }
-  return out;
-}
 
-// A decimal number, locale-independent, as the table reader reads them.
-std::optional<double> ParseNumber(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  if (text.empty() || text.front() == '+') return std::nullopt;
-  double value = 0;
-  auto [end, ec] = fast_float::from_chars(text.data(), text.data() + text.size(), value);
-  if (end != text.data() + text.size()) return std::nullopt;
-  if (ec == std::errc::result_out_of_range) return std::abs(value) < 1 ? 0.0 : HUGE_VAL;
-  if (ec != std::errc()) return std::nullopt;
-  return value;
-}
 
 std::string NumberHint(std::string_view text) {
   if (text.find(',') != std::string_view::npos) return " (write the decimal point as '.')";

@@ -51,7 +51,7 @@ std::string CommentText(std::string_view text) {
     while (!out.empty() && out.back() == ' ') out.pop_back();
     return out;
   }
-  std::string out = cad::Printable(text);
+  std::string out = Printable(text);
   // Printable shows control bytes as \xNN; a tab or line end in a value
   // reads better as a space.
   for (std::string_view control : {"\\x09", "\\x0a", "\\x0d"}) {
@@ -136,7 +136,7 @@ struct NameOwner {
   std::uint32_t line = 0;  // the part's line
   std::string Describe() const {
     if (name.empty()) return std::string(what);
-    std::string text = fmt::format("{} '{}'", what, cad::Printable(name));
+    std::string text = fmt::format("{} '{}'", what, Printable(name));
     if (line != 0) text += fmt::format(" (line {})", line);
     return text;
   }
@@ -220,7 +220,7 @@ class NameTable {
 
 // 'text' for a message, or "none" when the list gives none.
 std::string Quoted(std::string_view text) {
-  return text.empty() ? std::string("none") : fmt::format("'{}'", cad::Printable(text));
+  return text.empty() ? std::string("none") : fmt::format("'{}'", Printable(text));
 }
 
 // "C1 10uF C_0805_2012Metric": what a part is, for its trailing comments.
@@ -292,7 +292,7 @@ bool CadImporter::Classify(const cad::Row& row, Part& part) {
   if (!options_.keep_dnp && (row.dnp || IsDnpValue(row.value))) {
     part.skip = SkipReason::kDnp;
     part.skip_detail = static_cast<int>(skip_details_.size());
-    skip_details_.push_back({row.dnp ? "the DNP column" : fmt::format("its value '{}'", cad::Printable(row.value))});
+    skip_details_.push_back({row.dnp ? "the DNP column" : fmt::format("its value '{}'", Printable(row.value))});
     part.skip_range = row.dnp ? row.dnp_range : row.value_range;
     return true;
   }
@@ -302,7 +302,7 @@ bool CadImporter::Classify(const cad::Row& row, Part& part) {
       if (!cad::GlobMatch(pattern, text)) continue;
       part.skip = SkipReason::kExcluded;
       part.skip_detail = static_cast<int>(skip_details_.size());
-      skip_details_.push_back({std::string(field), cad::Printable(text), std::string(rule), cad::Printable(pattern)});
+      skip_details_.push_back({std::string(field), Printable(text), std::string(rule), Printable(pattern)});
       part.skip_range = range;
       return true;
     }
@@ -347,7 +347,7 @@ void CadImporter::Add(const cad::Row& row) {
 }
 
 void CadImporter::ReportSkip(const Part& part, cad::Side placed_side) {
-  std::string designator = cad::Printable(part.designator);
+  std::string designator = Printable(part.designator);
   if (part.side != placed_side) {
     diags_.Report(DiagKind::ImportSkippedSide, part.side_range, designator, cad::SideName(part.side),
                   cad::SideName(placed_side));
@@ -382,7 +382,7 @@ void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
   for (const std::vector<const Part*>& group : groups) {
     std::string names;
     for (std::size_t i = 0; i < group.size() && i < kNamesShown; ++i) {
-      names += (i == 0 ? "" : ", ") + cad::Printable(group[i]->designator);
+      names += (i == 0 ? "" : ", ") + Printable(group[i]->designator);
     }
     if (group.size() > kNamesShown) names += ", ...";
     Diagnostics::AddNote(error, group.front()->designator_range,
@@ -519,7 +519,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       continue;
     }
     if (next_pallet > limits::kPalletNumberMax) {
-      diags_.Report(DiagKind::ImportTooManyPallets, feeder.name_range, cad::Printable(feeder.name), next_pallet,
+      diags_.Report(DiagKind::ImportTooManyPallets, feeder.name_range, Printable(feeder.name), next_pallet,
                     kFirstPallet, limits::kPalletNumberMax);
       continue;
     }
@@ -570,10 +570,10 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       // collision with the point of the same designator.
       if (b == 0 && taken) {
         if (taken->what == "the point of" && Lower(taken->name) == Lower(part.designator)) {
-          diags_.Report(DiagKind::ImportDuplicateDesignator, part.designator_range, cad::Printable(part.designator),
+          diags_.Report(DiagKind::ImportDuplicateDesignator, part.designator_range, Printable(part.designator),
                         taken->line, name);
         } else {
-          diags_.Report(DiagKind::ImportNameCollision, part.designator_range, cad::Printable(part.designator), wanted,
+          diags_.Report(DiagKind::ImportNameCollision, part.designator_range, Printable(part.designator), wanted,
                         fmt::format("that is {}", taken->Describe()), name);
         }
       }
@@ -617,7 +617,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
           if (k == 0) {
             k = ++pockets_used[f];
             if (k == feeder.pick_points() + 1) {
-              diags_.Report(DiagKind::ImportPalletFeederFull, part->designator_range, cad::Printable(feeder.name),
+              diags_.Report(DiagKind::ImportPalletFeederFull, part->designator_range, Printable(feeder.name),
                             feeder.pick_points(), feeder.pick_points() == 1 ? "point" : "points", feeder.columns,
                             feeder.rows, k);
             }

@@ -58,8 +58,8 @@ std::string BaseName(const std::string& path) {
 std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
   std::size_t comma = text.find(',');
   if (comma == std::string::npos) return std::nullopt;
-  std::optional<double> a = cad::ParseNumber(text.substr(0, comma));
-  std::optional<double> b = cad::ParseNumber(text.substr(comma + 1));
+  std::optional<double> a = ParseNumber(text.substr(0, comma));
+  std::optional<double> b = ParseNumber(text.substr(comma + 1));
   if (!a || !b || !std::isfinite(*a) || !std::isfinite(*b) || std::abs(*a) > kMaxLengthMm ||
       std::abs(*b) > kMaxLengthMm) {
     return std::nullopt;
@@ -118,7 +118,7 @@ const cell::Fixture* ChooseFixture(const cell::Cell& cell, const std::string& wa
     if (cell.fixtures.empty()) {
       diags.Report(DiagKind::ImportNoFixture, cell_start);
     } else {
-      diags.Report(DiagKind::ImportUnknownFixture, cell.fixtures.front().name_range, cad::Printable(wanted),
+      diags.Report(DiagKind::ImportUnknownFixture, cell.fixtures.front().name_range, Printable(wanted),
                    closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), list);
     }
     return nullptr;

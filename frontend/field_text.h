@@ -1,0 +1,27 @@
+// Reading and showing the text of one field of a user's file, shared by every
+// reader of CSV-like files (error tables and point lists, trip files, CAD
+// placement lists), so they accept the same numbers and print the same way.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace smtcal {
+
+// The length of the valid UTF-8 sequence at text[i], or 0 if there is none.
+std::size_t Utf8Length(std::string_view text, std::size_t i);
+
+// A field's text for a message: control characters and bytes that are not
+// UTF-8 shown as \xNN, so a binary file cannot garble the terminal, cut a
+// message short, or make the JSON output invalid.
+std::string Printable(std::string_view text);
+
+// A decimal number written exactly as `text` (optional sign, digits, '.',
+// exponent), read locale-independently with fast_float. nullopt when it is
+// not exactly one number; an overflow gives HUGE_VAL (so range checks report
+// it as not finite), an underflow 0.
+std::optional<double> ParseNumber(std::string_view text);
+
+}  // namespace smtcal
