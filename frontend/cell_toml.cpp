@@ -24,6 +24,7 @@
 #include <toml++/toml.h>
 
 #include "frontend/table_csv.h"
+#include "frontend/toml_source.h"
 #include "passes/error_table_check.h"
 #include "passes/fixture_geometry.h"
 #include "passes/limits.h"
@@ -157,29 +158,13 @@ class Keys {
 class Loader {
  public:
   Loader(SourceManager& sources, Diagnostics& diags, std::uint32_t file, std::filesystem::path dir)
-      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)) {}
+      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)), locator_(sources, file) {}
 
   Diagnostics& diags() { return diags_; }
 
-  // toml++ counts columns in code points, after a byte order mark;
-  // SourceLoc counts bytes from the start of the line.
-  SourceLoc At(const toml::source_position& position) const {
-    if (position.line == 0) return SourceLoc{file_, 0, 0};
-    std::string_view line = sources_.File(file_).Line(position.line);
-    std::size_t byte = position.line == 1 && line.starts_with("\xEF\xBB\xBF") ? 3 : 0;
-    for (std::uint32_t code_point = 1; code_point < position.column && byte < line.size(); ++code_point) {
-      ++byte;
-      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
-    }
-    return SourceLoc{file_, position.line, static_cast<std::uint32_t>(byte + 1)};
-  }
-  SourceRange Range(const toml::source_region& region) const {
-    SourceLoc begin = At(region.begin);
-    if (region.end.line != region.begin.line || region.end.column <= region.begin.column) return SourceRange(begin);
-    SourceLoc end = At(region.end);
-    return SourceRange(begin, end.column - begin.column);
-  }
-  SourceRange Range(const toml::node& node) const { return Range(node.source()); }
+  SourceLoc At(const toml::source_position& position) const { return locator_.At(position); }
+  SourceRange Range(const toml::source_region& region) const { return locator_.Range(region); }
+  SourceRange Range(const toml::node& node) const { return locator_.Range(node); }
   SourceRange WholeFile() const { return SourceRange(SourceLoc{file_, 0, 0}); }
 
   std::optional<Cell> Load(const toml::table& root, const std::string& path);
@@ -219,6 +204,7 @@ class Loader {
   Diagnostics& diags_;
   std::uint32_t file_;
   std::filesystem::path dir_;
+  TomlLocator locator_;
   Robot robot_;
   bool robot_ok_ = false;
   std::map<std::string, LoadedTable> tables_;  // by resolved path: a table shared by regions is read once

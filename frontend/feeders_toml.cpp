@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "frontend/cad_text.h"
+#include "frontend/toml_source.h"
 #include "passes/limits.h"
 #include "passes/tolerances.h"
 
@@ -38,25 +39,11 @@ std::string_view TypeName(const toml::node& node) {
 class Reader {
  public:
   Reader(const SourceManager& sources, std::uint32_t file, Diagnostics& diags)
-      : sources_(sources), file_(file), diags_(diags) {}
+      : sources_(sources), file_(file), diags_(diags), locator_(sources, file) {}
 
-  // toml++ counts columns in code points; our locations count bytes.
-  SourceLoc At(const toml::source_position& position) const {
-    if (position.line == 0) return SourceLoc{file_, 1, 1};
-    std::string_view line = sources_.File(file_).Line(position.line);
-    std::size_t byte = 0;
-    for (std::uint32_t code_point = 1; code_point < position.column && byte < line.size(); ++code_point) {
-      ++byte;
-      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
-    }
-    return SourceLoc{file_, position.line, static_cast<std::uint32_t>(byte + 1)};
-  }
-  SourceRange Range(const toml::source_region& region) const {
-    SourceLoc begin = At(region.begin);
-    if (region.end.line != region.begin.line || region.end.column <= region.begin.column) return SourceRange(begin);
-    return SourceRange(begin, At(region.end).column - begin.column);
-  }
-  SourceRange Range(const toml::node& node) const { return Range(node.source()); }
+  SourceLoc At(const toml::source_position& position) const { return locator_.At(position); }
+  SourceRange Range(const toml::source_region& region) const { return locator_.Range(region); }
+  SourceRange Range(const toml::node& node) const { return locator_.Range(node); }
 
   std::optional<FeedersFile> Read(const toml::table& root) {
     const std::size_t errors_before = diags_.error_count();
@@ -237,6 +224,7 @@ class Reader {
   const SourceManager& sources_;
   std::uint32_t file_;
   Diagnostics& diags_;
+  TomlLocator locator_;
 };
 
 FeederSpec FromCell(const cell::Feeder& feeder) {

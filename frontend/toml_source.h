@@ -1,0 +1,44 @@
+// Locations in a TOML file for diagnostics, shared by the cell and feeders
+// loaders: toml++ counts columns in code points (after a byte order mark),
+// SourceLoc counts bytes from the start of the line.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+#include <toml++/toml.h>
+
+#include "frontend/diagnostics.h"
+#include "frontend/source.h"
+
+namespace smtcal {
+
+class TomlLocator {
+ public:
+  TomlLocator(const SourceManager& sources, std::uint32_t file) : sources_(sources), file_(file) {}
+
+  // An unknown position (line 0) gives a location in the file without a line.
+  SourceLoc At(const toml::source_position& position) const {
+    if (position.line == 0) return SourceLoc{file_, 0, 0};
+    std::string_view line = sources_.File(file_).Line(position.line);
+    std::size_t byte = position.line == 1 && line.starts_with("\xEF\xBB\xBF") ? 3 : 0;
+    for (std::uint32_t code_point = 1; code_point < position.column && byte < line.size(); ++code_point) {
+      ++byte;
+      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
+    }
+    return SourceLoc{file_, position.line, static_cast<std::uint32_t>(byte + 1)};
+  }
+  // The region on its first line (a region over several lines: its start).
+  SourceRange Range(const toml::source_region& region) const {
+    SourceLoc begin = At(region.begin);
+    if (region.end.line != region.begin.line || region.end.column <= region.begin.column) return SourceRange(begin);
+    return SourceRange(begin, At(region.end).column - begin.column);
+  }
+  SourceRange Range(const toml::node& node) const { return Range(node.source()); }
+
+ private:
+  const SourceManager& sources_;
+  std::uint32_t file_;
+};
+
+}  // namespace smtcal
