@@ -37,5 +37,7 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options);  // compile and v
 void AddFixtureCommand(CLI::App& app, GlobalOptions& options);
 void AddImportCommand(CLI::App& app, GlobalOptions& options);
 void AddCellCommand(CLI::App& app, GlobalOptions& options);
+void AddDiffCommand(CLI::App& app, GlobalOptions& options);
+void AddSimulateCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
   AddFixtureCommand(app, options);
   AddImportCommand(app, options);
   AddCellCommand(app, options);
+  AddDiffCommand(app, options);
+  AddSimulateCommand(app, options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
