@@ -178,6 +178,20 @@ struct Feeder {
   SourceRange range;  // the [[feeder]] table
 };
 
+// [linuxcnc]: how the cell's LinuxCNC controller is wired, for
+// `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that
+// target needs it (and reports its absence).
+struct LinuxCnc {
+  char rotation_axis = 'C';      // the axis word u is commanded on: A, B or C
+  int vacuum_sensor_input = 0;   // motion.digital-in-NN the gripper's vacuum sensor is wired to
+  double vacuum_timeout_s = 0;   // how long a Pick/Place waits for the sensor before aborting (> 0)
+  SourceRange range;             // the [linuxcnc] table
+};
+
+// LinuxCNC's motion controller has at most 64 digital inputs and outputs
+// (motion.digital-in/out-00..63, [EMCMOT]num_dio).
+inline constexpr int kLinuxCncMaxDio = 64;
+
 struct Cell {
   std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
   std::string path;    // the cell file as given
@@ -186,6 +200,7 @@ struct Cell {
   std::vector<Region> regions;  // pairwise without common interior (they may share an edge)
   std::vector<Fixture> fixtures;
   std::vector<Feeder> feeders;
+  std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
 
   const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
   const Region* FindRegion(std::string_view name) const;    // case-insensitive

@@ -44,6 +44,8 @@ constexpr std::array<std::string_view, 4> kEdgeNames = {"p1", "p2", "p3", "p4"};
 // The robot's limits, in the order of Robot::limits.
 constexpr std::array<std::string_view, 4> kLimitKeys = {"x_mm", "y_mm", "z_mm", "u_deg"};
 constexpr std::array<std::string_view, 4> kLimitUnits = {"mm", "mm", "mm", "deg"};
+// The axis words [linuxcnc] rotation_axis may name.
+constexpr std::array<std::string_view, 3> kRotationAxisNames = {"A", "B", "C"};
 
 std::string Lowercase(std::string_view text) {
   std::string lower(text);
@@ -189,6 +191,7 @@ class Loader {
   bool ReadScanPaths(Keys& keys, Fixture& fixture);
   bool ReadFixtureLimits(Keys& keys, Fixture& fixture);
   std::optional<Feeder> ReadFeeder(const toml::table& table, int index, Names& names);
+  std::optional<LinuxCnc> ReadLinuxCnc(const toml::table& table);
 
   bool CheckMarkerGeometry(const Fixture& fixture, Keys& keys);
   bool CheckScanTrips(const Fixture& fixture);
@@ -1028,6 +1031,24 @@ std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
 
 // ------------------------------------------------------------------ the file
 
+// ------------------------------------------------------------------ linuxcnc
+
+std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
+  const std::size_t errors_before = diags_.error_count();
+  Keys keys(*this, table, "[linuxcnc]", Range(table));
+  LinuxCnc linuxcnc;
+  linuxcnc.range = Range(table);
+  if (std::optional<int> axis = Choice(keys, "rotation_axis", kRotationAxisNames)) {
+    linuxcnc.rotation_axis = kRotationAxisNames[static_cast<std::size_t>(*axis)][0];
+  }
+  linuxcnc.vacuum_sensor_input =
+      IntegerIn(keys, "vacuum_sensor_input", 0, kLinuxCncMaxDio - 1, "motion.digital-in-NN").value_or(0);
+  linuxcnc.vacuum_timeout_s = PositiveNumber(keys, "vacuum_timeout_s", "s").value_or(0);
+  keys.Finish();
+  if (diags_.error_count() != errors_before) return std::nullopt;
+  return linuxcnc;
+}
+
 std::string DefaultCellName(const std::string& path) {
   if (path == "-") return "cell";
   std::string name = std::filesystem::path(path).filename().string();
@@ -1068,6 +1089,9 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
     if (auto feeder = ReadFeeder(*feeders[i], static_cast<int>(i), feeder_names)) {
       cell.feeders.push_back(std::move(*feeder));
     }
+  }
+  if (const toml::table* linuxcnc = TableAt(keys, "linuxcnc", Need::kOptional, "a [linuxcnc] table")) {
+    cell.linuxcnc = ReadLinuxCnc(*linuxcnc);
   }
   keys.Finish();
 

@@ -114,4 +114,20 @@ inline constexpr int kRigidMaxIterations = 20;
 // against rounding (relative error about 1e-8).
 inline constexpr double kSensorShareStepMm = 1e-4;
 
+// --- smtcal diff (backend/program_diff.cpp, docs/diff.md) --------------------
+
+// Two positions closer than this are the same position: compiled programs
+// print coordinates to 1e-10 mm, so re-printing alone never moves a target
+// by a nanometre, and a real change in a table is thousands of times larger.
+inline constexpr double kDiffSamePositionMm = 1e-6;
+inline constexpr double kDiffSameAngleDeg = 1e-6;
+// The deployment gate's default: a target that moved by more than this (µm)
+// fails `smtcal diff`. A tenth of the paper cell's +-0.1 mm tolerance.
+inline constexpr double kDiffDefaultThresholdUm = 10;
+// Statement alignment: the exact dynamic programme runs on at most this many
+// cells (about 32 MB); larger differing middles use Myers' O(ND) alignment,
+// which gives up beyond kDiffMaxEditDistance edits in one function.
+inline constexpr double kDiffMaxAlignCells = 4e6;
+inline constexpr long kDiffMaxEditDistance = 2000;
+
 }  // namespace smtcal

@@ -25,4 +25,10 @@ echo "== smtcal compile $example/layers.place --cell $example/paper.cell.toml -o
 build/smtcal compile "$example/layers.place" --cell "$example/paper.cell.toml" \
   -o build/layers.corrected.place --report build/layers.report.json
 diff "$example/layers.place" build/layers.corrected.place | head -n 30 || true
+echo "== smtcal compile $example/layers.place --cell $example/paper.cell.toml --target linuxcnc -o build/layers-linuxcnc"
+build/smtcal compile "$example/layers.place" --cell "$example/paper.cell.toml" --target linuxcnc -o build/layers-linuxcnc
+head -n 12 build/layers-linuxcnc/layers.ngc
+ls build/layers-linuxcnc/subroutines
+echo "== smtcal simulate $example/layers.place --cell $example/paper.cell.toml --cycles 1000 --seed 1"
+build/smtcal simulate "$example/layers.place" --cell "$example/paper.cell.toml" --cycles 1000 --seed 1
 echo "bootstrap: done; smtcal is build/smtcal"

@@ -5,6 +5,7 @@
 
 #include "backend/c_data.h"
 #include "backend/compile_report.h"
+#include "backend/linuxcnc_emit.h"
 #include "backend/place_printer.h"
 #include "frontend/cell.h"
 #include "frontend/parse.h"
@@ -114,9 +115,14 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   Diagnostics diags(sources);
   Compiled compiled;
   if (!CompileProgram(opt, sources, diags, compiled, options)) return;
+  const CompileState& state = *compiled.program.compile;
+  // The LinuxCNC emitter reports what it cannot lower with the passes' diagnostics.
+  std::optional<LinuxCncOutput> linuxcnc;
+  if (opt.target == "linuxcnc" && !diags.has_errors()) {
+    linuxcnc = EmitLinuxCnc(compiled.program, state, opt.program_path, diags);
+  }
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;  // nothing half-written
-  const CompileState& state = *compiled.program.compile;
   std::string text;
   if (opt.target == "c") {
     for (const cell::Fixture& fixture : compiled.cell->fixtures) {
@@ -127,7 +133,7 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       return;
     }
     text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
-  } else {
+  } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
     text = PrintPlace(compiled.program);
   }
@@ -138,9 +144,10 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       return;
     }
   }
-  if (Status written = WriteFileAtomically(opt.output, text); !written) {
-    options.exit_code = ReportIoError(written.error());
-  }
+  Status written = !linuxcnc             ? WriteFileAtomically(opt.output, text)
+                   : opt.output == "-"    ? WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc))
+                                          : WriteLinuxCncDirectory(opt.output, *linuxcnc);
+  if (!written) options.exit_code = ReportIoError(written.error());
 }
 
 void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
@@ -173,11 +180,15 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
                  "points converted, a Scan injected into every Cycle; write the corrected program");
   AddCommonOptions(*compile, compile_options);
   compile->add_option("--target", compile_options.target,
-                      "what to write: place (the corrected program, same language) or c (the program's fixture "
-                      "points and the cell's tables as C data for runtime/c)")
-      ->check(CLI::IsMember({"place", "c"}))
+                      "what to write: place (the corrected program, same language), c (the program's fixture "
+                      "points and the cell's tables as C data for runtime/c) or linuxcnc (RS274NGC: -o names a "
+                      "directory that gets PROGRAM.ngc and subroutines/, docs/linuxcnc.md)")
+      ->check(CLI::IsMember({"place", "c", "linuxcnc"}))
       ->capture_default_str();
-  compile->add_option("-o,--output", compile_options.output, "the file to write ('-' for stdout)")->required();
+  compile->add_option("-o,--output", compile_options.output,
+                      "the file to write, the directory for --target linuxcnc ('-' for stdout: with linuxcnc, the "
+                      "main program and smtcal_data.ngc for review)")
+      ->required();
   compile->add_option("--report", compile_options.report,
                       "also write a JSON report of every motion target (required and nominal position, correction, "
                       "region, residual, budget) and the cycle-time estimate");
