@@ -200,11 +200,17 @@ class Emitter {
   // Base-frame statements: commanded as written when every target the
   // compile-time run found is static (the IR already holds its nominal
   // XY(...)) or uncorrected; corrected on the controller otherwise.
+  // Also remembers each statement's first target text and the program's
+  // Vacuum default, so emitting stays linear in the program's size.
   void ClassifyTargets() {
     for (const Target& target : state_.targets) {
       bool as_written = target.kind == CorrectionKind::kStatic || target.kind == CorrectionKind::kUncorrected;
       auto [it, inserted] = as_written_.emplace(target.stmt, as_written);
       if (!inserted) it->second = it->second && as_written;
+      target_text_.emplace(target.stmt, target.text);
+    }
+    for (const ir::StmtPtr& item : program_.items) {
+      if (const auto* decl = std::get_if<ir::VacuumDecl>(&item->node)) default_vacuum_ = decl->output;
     }
   }
 
@@ -736,18 +742,13 @@ class Emitter {
 
   // The target as the source wrote it (static targets' IR holds the nominal XY).
   std::string TargetText(const ir::Stmt& stmt, const ir::PointExpr& point) const {
-    for (const Target& target : state_.targets) {
-      if (target.stmt == &stmt) return target.text;
-    }
-    return PrintPointText(point);
+    auto it = target_text_.find(&stmt);
+    return it != target_text_.end() ? it->second : PrintPointText(point);
   }
 
   double DefaultVacuum() const {
-    for (const ir::StmtPtr& item : program_.items) {
-      if (const auto* decl = std::get_if<ir::VacuumDecl>(&item->node)) return decl->output;
-    }
-    SMTCAL_CHECK(false, "a checked Pick/Place without Vacuum has the program's Vacuum");
-    return 0;
+    SMTCAL_CHECK(default_vacuum_.has_value(), "a checked Pick/Place without Vacuum has the program's Vacuum");
+    return *default_vacuum_;
   }
 
   const ir::Program& program_;
@@ -758,6 +759,8 @@ class Emitter {
   std::string source_name_;
   Diagnostics& diags_;
   std::map<const ir::Stmt*, bool> as_written_;
+  std::map<const ir::Stmt*, std::string> target_text_;  // the first target's text
+  std::optional<int> default_vacuum_;                   // the program's `Vacuum n`
   std::map<const ir::Expr*, std::string> switches_;
   std::set<std::string> locals_;  // the current function's, lowercase
   std::string function_;          // the current function, lowercase
