@@ -3,7 +3,7 @@
 // and the output directory that holds it with the runtime subroutines
 // (docs/linuxcnc.md has the lowering table, the directory and the checks).
 //
-// The main program calls the runtime (runtime/linuxcnc/*.ngc, L1's) for
+// The main program calls the runtime (runtime/linuxcnc/*.ngc) for
 // everything that happens on the controller: loading the cell's data, the
 // marker scan and the correction of fixture and run-time targets. Static
 // targets are the nominal coordinates the passes computed.

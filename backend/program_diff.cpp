@@ -336,16 +336,6 @@ std::string Signature(const ir::Stmt& stmt, int branch) {
       stmt.node);
 }
 
-int AxisIndex(ir::Axis axis) {
-  switch (axis) {
-    case ir::Axis::X: return 0;
-    case ir::Axis::Y: return 1;
-    case ir::Axis::Z: return 2;
-    case ir::Axis::U: return 3;
-  }
-  return 0;
-}
-
 class SideModel {
  public:
   SideModel(const ir::Program& program) : program_(program), symbols_(sema::SymbolTable::Build(program)) {}
@@ -392,7 +382,7 @@ class SideModel {
     for (const ir::PointOffset& offset : target.offsets) {
       std::optional<sema::Constant> amount = sema::FoldConstant(offset.amount.get());
       if (amount) {
-        p.written[AxisIndex(offset.axis)] += offset.negative ? -amount->value : amount->value;
+        p.written[ir::AxisIndex(offset.axis)] += offset.negative ? -amount->value : amount->value;
       } else {
         p.symbolic += fmt::format(" {} {}({})", offset.negative ? '-' : '+', ir::AxisSpelling(offset.axis),
                                   PrintExpr(*offset.amount));

@@ -46,6 +46,16 @@ std::string_view AxisSpelling(Axis axis) {
   return "";
 }
 
+int AxisIndex(Axis axis) {
+  switch (axis) {
+    case Axis::X: return 0;
+    case Axis::Y: return 1;
+    case Axis::Z: return 2;
+    case Axis::U: return 3;
+  }
+  return 0;
+}
+
 std::string_view MotionSpelling(MotionKind kind) {
   switch (kind) {
     case MotionKind::Jump: return "Jump";

@@ -16,6 +16,8 @@ std::string_view BinaryOpSpelling(BinaryOp op);
 std::string_view UnaryOpSpelling(UnaryOp op);
 // "X", "Y", "Z", "U".
 std::string_view AxisSpelling(Axis axis);
+// 0, 1, 2, 3: the axis's place in Coords::values (x, y, z, u).
+int AxisIndex(Axis axis);
 // "Jump", "Go", "Move".
 std::string_view MotionSpelling(MotionKind kind);
 // "Pick", "Place".

@@ -13,6 +13,7 @@
 
 #include "backend/place_printer.h"
 #include "frontend/check.h"
+#include "passes/ir_ops.h"
 #include "passes/ir_walk.h"
 
 namespace smtcal {
@@ -20,16 +21,6 @@ namespace {
 
 using Value = std::optional<double>;  // nullopt: known only at run time
 using Variables = std::map<std::string, Value>;
-
-int AxisIndex(ir::Axis axis) {
-  switch (axis) {
-    case ir::Axis::X: return 0;
-    case ir::Axis::Y: return 1;
-    case ir::Axis::Z: return 2;
-    case ir::Axis::U: return 3;
-  }
-  return 0;
-}
 
 // What a target's position depends on that is not known before run time.
 struct Unknown {
@@ -167,7 +158,7 @@ class Tracer {
     for (const ir::PointOffset& offset : target.offsets) {
       Value amount = Eval(offset.amount.get(), frame);
       if (!amount) return Unknown{FirstUnknown(offset.amount.get(), frame)};
-      local[AxisIndex(offset.axis)] += offset.negative ? -*amount : *amount;
+      local[ir::AxisIndex(offset.axis)] += offset.negative ? -*amount : *amount;
     }
     if (taught_decl != nullptr) {
       // Taught coordinates are robot coordinates; the frame is the fixture.

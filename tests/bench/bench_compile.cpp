@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "backend/linuxcnc_emit.h"
 #include "backend/place_printer.h"
 #include "frontend/cell.h"
 #include "frontend/parse.h"
@@ -39,8 +40,11 @@ std::string GeneratePlacements(int placements) {
   return text;
 }
 
+// state.range(1): 0 emits the corrected .place program, 1 the LinuxCNC
+// program (DESIGN's target: "to a verified LinuxCNC program").
 void BM_Compile100kPlacements(benchmark::State& state) {
   const int placements = static_cast<int>(state.range(0));
+  const bool linuxcnc = state.range(1) == 1;
   const std::string text = GeneratePlacements(placements);
   const std::string cell_path = SMTCAL_SOURCE_DIR "/examples/paper-cell/paper.cell.toml";
   std::size_t errors = 0, bytes = 0;
@@ -60,7 +64,17 @@ void BM_Compile100kPlacements(benchmark::State& state) {
     std::vector<const PassInfo*> passes;
     for (const PassInfo& info : CorrectionPassRegistry()) passes.push_back(&info);
     RunPasses(program, diags, passes, false);
-    std::string corrected = PrintPlace(program);
+    std::string corrected;
+    if (linuxcnc) {
+      std::optional<LinuxCncOutput> output = EmitLinuxCnc(program, *program.compile, "bench.place", diags);
+      if (!output) {
+        state.SkipWithError("the LinuxCNC target refused the generated program");
+        return;
+      }
+      corrected = std::move(output->main_text);
+    } else {
+      corrected = PrintPlace(program);
+    }
     bytes = corrected.size();
     errors = diags.error_count();
     benchmark::DoNotOptimize(corrected);
@@ -70,7 +84,12 @@ void BM_Compile100kPlacements(benchmark::State& state) {
   state.counters["output_mb"] = static_cast<double>(bytes) / 1e6;
   state.counters["peak_rss_mb"] = bench::PeakRssMb();
 }
-BENCHMARK(BM_Compile100kPlacements)->Arg(100000)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_Compile100kPlacements)
+    ->Args({100000, 0})
+    ->Args({100000, 1})
+    ->ArgNames({"placements", "linuxcnc"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
 
 }  // namespace
 }  // namespace smtcal

@@ -1,0 +1,282 @@
+// Reading the truth file of `smtcal simulate` (frontend/truth_toml.h).
+#include "frontend/truth_toml.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "frontend/field_text.h"
+#include "frontend/table_csv.h"
+#include "frontend/toml_source.h"
+#include "passes/error_table_check.h"
+
+namespace smtcal {
+namespace {
+
+std::string Lower(std::string_view text) {
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower;
+}
+
+std::string_view TypeName(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+// 'a', 'b' and 'c' (or: 'a', 'b' or 'c').
+std::string Listed(const std::vector<std::string>& names, std::string_view last = " and ") {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    text += (i == 0 ? std::string() : i + 1 == names.size() ? std::string(last) : std::string(", ")) +
+            fmt::format("'{}'", names[i]);
+  }
+  return text.empty() ? "none" : text;
+}
+
+class Reader {
+ public:
+  Reader(SourceManager& sources, std::uint32_t file, const cell::Cell& cell, Diagnostics& diags,
+         std::filesystem::path dir)
+      : sources_(sources), file_(file), cell_(cell), diags_(diags), dir_(std::move(dir)), locator_(sources, file) {}
+
+  SourceLoc At(const toml::source_position& position) const { return locator_.At(position); }
+  SourceRange Range(const toml::node& node) const { return locator_.Range(node); }
+
+  std::optional<TruthSpec> Read(const toml::table& root, const std::string& path) {
+    const std::size_t errors_before = diags_.error_count();
+    TruthSpec spec;
+    spec.path = path;
+    CheckKeys(root, "the truth file", {"noise", "field", "region", "board", "sensor", "robot"});
+    if (std::optional<bool> noise = Bool(root, "noise")) spec.noise = *noise;
+    if (const toml::table* field = Table(root, "field")) ReadField(*field, spec);
+    if (const toml::table* board = Table(root, "board")) ReadBoard(*board, spec.board);
+    if (const toml::table* sensor = Table(root, "sensor")) {
+      CheckKeys(*sensor, "[sensor]", {"accuracy_mm"});
+      spec.sensor_accuracy_mm = Number(*sensor, "accuracy_mm", 0, 5, "mm");
+    }
+    if (const toml::table* robot = Table(root, "robot")) {
+      CheckKeys(*robot, "[robot]", {"repeatability_mm"});
+      spec.repeatability_mm = Number(*robot, "repeatability_mm", 0, 5, "mm");
+    }
+    for (const toml::table* region : Tables(root, "region")) ReadRegion(*region, spec);
+    if (diags_.error_count() != errors_before) return std::nullopt;
+    return spec;
+  }
+
+ private:
+  void ReadField(const toml::table& table, TruthSpec& spec) {
+    CheckKeys(table, "[field]",
+              {"tables", "perturbation_scale", "outside", "fade_mm", "offset_mm", "rotation_deg", "about_mm",
+               "scale_ppm"});
+    if (std::optional<int> tables = Choice(table, "tables", {"derived", "cell", "none"})) {
+      spec.tables = static_cast<TruthTables>(*tables);
+    }
+    spec.perturbation_scale = Number(table, "perturbation_scale", 0, 100, "").value_or(spec.perturbation_scale);
+    if (std::optional<int> outside = Choice(table, "outside", {"fade", "clamp"})) {
+      spec.outside = static_cast<TruthOutside>(*outside);
+    }
+    spec.fade_mm = Number(table, "fade_mm", 0, 1000, "mm").value_or(spec.fade_mm);
+    spec.offset_mm = Point(table, "offset_mm", 10).value_or(spec.offset_mm);
+    spec.rotation_deg = Number(table, "rotation_deg", -5, 5, "deg").value_or(spec.rotation_deg);
+    spec.about_mm = Point(table, "about_mm", 1e5).value_or(spec.about_mm);
+    spec.scale_ppm = Number(table, "scale_ppm", -1e4, 1e4, "ppm").value_or(spec.scale_ppm);
+  }
+
+  void ReadBoard(const toml::table& table, BoardPoseModel& board) {
+    CheckKeys(table, "[board]",
+              {"shift", "shift_scale_mm", "shift_max_mm", "fixed_shift_mm", "rotation_sd_deg", "rotation_max_deg",
+               "fixed_rotation_deg"});
+    if (std::optional<int> shift = Choice(table, "shift", {"exponential", "normal", "uniform", "fixed"})) {
+      board.shift = static_cast<ShiftDistribution>(*shift);
+    }
+    board.shift_scale_mm = Number(table, "shift_scale_mm", 0, 10, "mm").value_or(board.shift_scale_mm);
+    board.shift_max_mm = Number(table, "shift_max_mm", 0, 50, "mm").value_or(board.shift_max_mm);
+    board.fixed_shift_mm = Point(table, "fixed_shift_mm", 50).value_or(board.fixed_shift_mm);
+    board.rotation_sd_deg = Number(table, "rotation_sd_deg", 0, 5, "deg").value_or(board.rotation_sd_deg);
+    board.rotation_max_deg = Number(table, "rotation_max_deg", 0, 10, "deg").value_or(board.rotation_max_deg);
+    board.fixed_rotation_deg = Number(table, "fixed_rotation_deg", -10, 10, "deg").value_or(board.fixed_rotation_deg);
+  }
+
+  void ReadRegion(const toml::table& table, TruthSpec& spec) {
+    CheckKeys(table, "[[region]]", {"name", "table"});
+    SourceRange name_range = Range(table);
+    std::optional<std::string> name = String(table, "name", &name_range);
+    SourceRange table_range = Range(table);
+    std::optional<std::string> file = String(table, "table", &table_range);
+    for (std::string_view key : {"name", "table"}) {
+      if (!table.contains(key)) {
+        diags_.Report(DiagKind::TruthWrongType, Range(table), key, "given in every [[region]]", "nothing");
+      }
+    }
+    if (!name || !file) return;
+    const cell::Region* region = cell_.FindRegion(*name);
+    if (region == nullptr) {
+      std::vector<std::string> names;
+      for (const cell::Region& r : cell_.regions) names.push_back(r.name);
+      diags_.Report(DiagKind::TruthUnknownRegion, name_range, Printable(*name), Listed(names));
+      return;
+    }
+    for (const TruthRegionTable& given : spec.region_tables) {
+      if (Lower(given.region) != Lower(region->name)) continue;
+      diags_.Report(DiagKind::TruthDuplicateRegion, name_range, region->name, given.range.begin.line);
+      return;
+    }
+    std::filesystem::path table_path = std::filesystem::path(*file);
+    if (table_path.is_relative()) table_path = dir_ / table_path;
+    Result<std::uint32_t> loaded = sources_.Load(table_path.string());
+    if (!loaded) {
+      diags_.Report(DiagKind::TruthTableUnreadable, table_range, loaded.error().message);
+      return;
+    }
+    std::optional<ErrorTable> read = ReadErrorTable(loaded.value(), diags_);
+    if (!read || !ValidateErrorTable(*read, diags_, TableWarnings::kSkip)) return;
+    spec.region_tables.push_back({region->name, std::move(*read), name_range});
+  }
+
+  void CheckKeys(const toml::table& table, std::string_view where, std::vector<std::string> known) {
+    for (const auto& [key, node] : table) {
+      (void)node;
+      if (std::find(known.begin(), known.end(), key.str()) != known.end()) continue;
+      std::string closest = ClosestName(key.str(), known);
+      diags_.Report(DiagKind::TruthUnknownKey, locator_.Range(key.source()), Printable(key.str()), where,
+                    closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest), Listed(known));
+    }
+  }
+
+  const toml::table* Table(const toml::table& root, std::string_view key) {
+    const toml::node* node = root.get(key);
+    if (node == nullptr) return nullptr;
+    if (!node->is_table()) {
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, fmt::format("a table written [{}]", key),
+                    TypeName(*node));
+      return nullptr;
+    }
+    return node->as_table();
+  }
+
+  std::vector<const toml::table*> Tables(const toml::table& root, std::string_view key) {
+    std::vector<const toml::table*> tables;
+    const toml::node* node = root.get(key);
+    if (node == nullptr) return tables;
+    const toml::array* array = node->as_array();
+    if (array == nullptr || !array->is_array_of_tables()) {
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, fmt::format("tables written [[{}]]", key),
+                    TypeName(*node));
+      return tables;
+    }
+    for (const toml::node& item : *array) tables.push_back(item.as_table());
+    return tables;
+  }
+
+  std::optional<bool> Bool(const toml::table& table, std::string_view key) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    if (!node->is_boolean()) {
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "true or false", TypeName(*node));
+      return std::nullopt;
+    }
+    return *node->value<bool>();
+  }
+
+  std::optional<std::string> String(const toml::table& table, std::string_view key, SourceRange* range = nullptr) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    if (range != nullptr) *range = Range(*node);
+    if (!node->is_string()) {
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "a string", TypeName(*node));
+      return std::nullopt;
+    }
+    return *node->value<std::string>();
+  }
+
+  // One of `choices`, as its index.
+  std::optional<int> Choice(const toml::table& table, std::string_view key, std::vector<std::string> choices) {
+    SourceRange range;
+    std::optional<std::string> value = String(table, key, &range);
+    if (!value) return std::nullopt;
+    for (std::size_t i = 0; i < choices.size(); ++i) {
+      if (choices[i] == *value) return static_cast<int>(i);
+    }
+    diags_.Report(DiagKind::TruthBadValue, range, key, fmt::format("one of {}", Listed(choices, " or ")),
+                  fmt::format("'{}'", Printable(*value)));
+    return std::nullopt;
+  }
+
+  std::optional<double> NumberOf(const toml::node& node, std::string_view key, double lo, double hi,
+                                 std::string_view unit) {
+    if (!node.is_number()) {
+      diags_.Report(DiagKind::TruthWrongType, Range(node), key, "a number", TypeName(node));
+      return std::nullopt;
+    }
+    const double value = *node.value<double>();
+    if (!std::isfinite(value) || value < lo || value > hi) {
+      std::string unit_text = unit.empty() ? "" : fmt::format(" {}", unit);
+      diags_.Report(DiagKind::TruthBadValue, Range(node), key, fmt::format("within {}..{}{}", lo, hi, unit_text),
+                    fmt::format("{}", value));
+      return std::nullopt;
+    }
+    return value;
+  }
+
+  std::optional<double> Number(const toml::table& table, std::string_view key, double lo, double hi,
+                               std::string_view unit) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    return NumberOf(*node, key, lo, hi, unit);
+  }
+
+  // [x, y] in mm, each within +-limit.
+  std::optional<Eigen::Vector2d> Point(const toml::table& table, std::string_view key, double limit) {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    const toml::array* array = node->as_array();
+    if (array == nullptr || array->size() != 2) {
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "[x, y]: two numbers in mm",
+                    array == nullptr ? std::string(TypeName(*node)) : fmt::format("an array of {} items", array->size()));
+      return std::nullopt;
+    }
+    std::optional<double> x = NumberOf(*array->get(0), key, -limit, limit, "mm");
+    std::optional<double> y = NumberOf(*array->get(1), key, -limit, limit, "mm");
+    if (!x || !y) return std::nullopt;
+    return Eigen::Vector2d(*x, *y);
+  }
+
+  SourceManager& sources_;
+  std::uint32_t file_;
+  const cell::Cell& cell_;
+  Diagnostics& diags_;
+  std::filesystem::path dir_;
+  TomlLocator locator_;
+};
+
+}  // namespace
+
+Result<std::optional<TruthSpec>> LoadTruth(const std::string& path, const cell::Cell& cell, SourceManager& sources,
+                                           Diagnostics& diags) {
+  Result<std::uint32_t> file = sources.Load(path);
+  if (!file) return file.error();
+  const SourceFile& source = sources.File(file.value());
+  Reader reader(sources, file.value(), cell, diags, std::filesystem::path(path).parent_path());
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(source.text), std::string_view(source.name));
+  } catch (const toml::parse_error& error) {
+    diags.Report(DiagKind::TruthSyntax, SourceRange(reader.At(error.source().begin)), std::string(error.description()));
+    return std::optional<TruthSpec>();
+  }
+  return reader.Read(root, path);
+}
+
+}  // namespace smtcal
