@@ -11,6 +11,8 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "backend/svg_text.h"
+
 namespace smtcal::diff {
 namespace {
 
@@ -212,20 +214,6 @@ constexpr double kUmPerMm = 1000;
 
 std::string Num(double v) { return fmt::format("{:.2f}", NoNegativeZero(v, 0.01)); }
 
-std::string Escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 // The largest 1, 2 or 5 times a power of ten not above v (v > 0).
 double NiceFloor(double v) {
   double power = std::pow(10.0, std::floor(std::log10(v)));
@@ -350,7 +338,7 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
       Num(width), Num(total_height));
   svg += "  <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   svg += fmt::format("  <text x=\"{}\" y=\"28\" font-size=\"17\" font-weight=\"bold\">What moves: {} -&gt; {}</text>\n",
-                     Num(kMarginPx), Escape(diff.old_file), Escape(diff.new_file));
+                     Num(kMarginPx), SvgEscape(diff.old_file), SvgEscape(diff.new_file));
   svg += fmt::format(
       "  <text x=\"{}\" y=\"50\" fill=\"#333\">grey: unchanged targets; blue dot and arrow: a moved target, "
       "old position to new, the arrow {} times enlarged (red: more than {} µm)</text>\n",
@@ -365,9 +353,9 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     svg += fmt::format("  <text x=\"{}\" y=\"130\">no target has a static position to draw</text>\n", Num(kMarginPx));
   }
   for (const Panel& p : panels) {
-    svg += fmt::format("  <!-- panel: {} -->\n", Escape(p.frame));
+    svg += fmt::format("  <!-- panel: {} -->\n", SvgEscape(p.frame));
     svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{} ({} targets)</text>\n",
-                       Num(p.left), Num(p.top - 12), Escape(p.frame), p.marks.size());
+                       Num(p.left), Num(p.top - 12), SvgEscape(p.frame), p.marks.size());
     svg += fmt::format("  <rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>\n",
                        Num(p.left), Num(p.top), Num(p.width), Num(p.height));
     svg += fmt::format("  <text x=\"{}\" y=\"{}\" fill=\"#555\">x {}..{} mm, y {}..{} mm</text>\n", Num(p.left),
@@ -398,7 +386,7 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
       double tx = (*c->old_plot)[0] + enlarge * ((*c->new_plot)[0] - (*c->old_plot)[0]);
       double ty = (*c->old_plot)[1] + enlarge * ((*c->new_plot)[1] - (*c->old_plot)[1]);
       svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"11\">{}: {} µm</text>\n", Num(p.Px(tx) + 6),
-                         Num(p.Py(ty) + (rank % 2 == 0 ? -4.0 : 12.0)), Escape(ShortName(*c)), Um(c->gate_um));
+                         Num(p.Py(ty) + (rank % 2 == 0 ? -4.0 : 12.0)), SvgEscape(ShortName(*c)), Um(c->gate_um));
     }
     svg += "  </g>\n";
   }

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "backend/svg_text.h"
 #include "frontend/check.h"
 
 namespace smtcal {
@@ -79,20 +80,6 @@ std::string Tick(double v) {
   while (text.back() == '0') text.pop_back();
   if (text.back() == '.') text.pop_back();
   return text == "-0" ? "0" : text;
-}
-
-std::string Escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 struct Panel {
@@ -256,7 +243,7 @@ std::string PlotTableSvg(const ErrorTable& table, std::string_view title) {
   svg += "    </linearGradient>\n  </defs>\n";
   svg += "  <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   svg += fmt::format("  <text x=\"{}\" y=\"26\" font-size=\"17\" font-weight=\"bold\">Error tables of {}</text>\n",
-                     Num(kMarginLeft - 40), Escape(title));
+                     Num(kMarginLeft - 40), SvgEscape(title));
   svg += fmt::format(
       "  <text x=\"{}\" y=\"46\" fill=\"#333\">colour: the error of the axis (µm, blue negative, red "
       "positive); arrows: the error vector (Δx, Δy) at each node, {} times enlarged; dots: grid nodes</text>\n",

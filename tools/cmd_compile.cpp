@@ -13,6 +13,7 @@
 #include "passes/correction_passes.h"
 #include "passes/pass_manager.h"
 #include "tools/commands.h"
+#include "tools/compile_pipeline.h"
 
 namespace smtcal::tools {
 namespace {
@@ -27,47 +28,6 @@ struct CompileOptions {
   bool verify_each = false;
 };
 
-// Parse, check, load the cell and run the correction passes. Returns false
-// (with options.exit_code set and everything printed) when there is nothing
-// to emit.
-struct Compiled {
-  ir::Program program;
-  std::optional<cell::Cell> cell;
-};
-
-bool CompileProgram(const CompileOptions& opt, SourceManager& sources, Diagnostics& diags, Compiled& out,
-                    GlobalOptions& options) {
-  Result<std::uint32_t> file = sources.Load(opt.program_path);
-  if (!file) {
-    options.exit_code = ReportIoError(file.error());
-    return false;
-  }
-  out.program = ParseProgram(file.value(), diags);
-  if (!diags.has_errors()) {
-    std::vector<const PassInfo*> checks;
-    for (const PassInfo& info : PassRegistry()) checks.push_back(&info);
-    RunPasses(out.program, diags, checks, opt.verify_each);
-  }
-  // The cell is loaded even when the program has errors, so both sets of
-  // mistakes are reported at once.
-  Result<std::optional<cell::Cell>> cell = cell::LoadCell(opt.cell_path, sources, diags);
-  if (!cell) {
-    PrintDiagnostics(diags, options);
-    options.exit_code = ReportIoError(cell.error());
-    return false;
-  }
-  out.cell = std::move(cell).value();
-  if (diags.has_errors() || !out.cell) {
-    options.exit_code = PrintDiagnostics(diags, options);
-    return false;
-  }
-  out.program.compile = std::make_shared<CompileState>();
-  out.program.compile->cell = &*out.cell;
-  std::vector<const PassInfo*> corrections;
-  for (const PassInfo& info : CorrectionPassRegistry()) corrections.push_back(&info);
-  RunPasses(out.program, diags, corrections, opt.verify_each);
-  return true;
-}
 
 ReportCounts Counts(const Diagnostics& diags) {
   return {static_cast<int>(diags.error_count()), static_cast<int>(diags.warning_count())};
@@ -113,8 +73,8 @@ std::string ProgramName(const ir::Program& program) {
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  Compiled compiled;
-  if (!CompileProgram(opt, sources, diags, compiled, options)) return;
+  CompiledProgram compiled;
+  if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
   const CompileState& state = *compiled.program.compile;
   // The LinuxCNC emitter reports what it cannot lower with the passes' diagnostics.
   std::optional<LinuxCncOutput> linuxcnc;
@@ -153,8 +113,8 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
 void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  Compiled compiled;
-  if (!CompileProgram(opt, sources, diags, compiled, options)) return;
+  CompiledProgram compiled;
+  if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
   options.exit_code = PrintDiagnostics(diags, options);
   const CompileState& state = *compiled.program.compile;
   std::string text = opt.json ? CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n"

@@ -15,6 +15,7 @@
 #include "passes/symbols.h"
 #include "passes/virtual_cell.h"
 #include "tools/commands.h"
+#include "tools/compile_pipeline.h"
 
 namespace smtcal::tools {
 namespace {
@@ -27,46 +28,6 @@ struct SimulateOptions {
   bool json = false;
   SimOptions sim;
 };
-
-struct Compiled {
-  ir::Program program;
-  std::optional<cell::Cell> cell;
-};
-
-// Parse, check, load the cell and run the correction passes, as `smtcal
-// compile` does (tools/cmd_compile.cpp). False when there is nothing to run
-// (everything printed, options.exit_code set).
-bool Compile(const SimulateOptions& opt, SourceManager& sources, Diagnostics& diags, Compiled& out,
-             GlobalOptions& options) {
-  Result<std::uint32_t> file = sources.Load(opt.program_path);
-  if (!file) {
-    options.exit_code = ReportIoError(file.error());
-    return false;
-  }
-  out.program = ParseProgram(file.value(), diags);
-  if (!diags.has_errors()) {
-    std::vector<const PassInfo*> checks;
-    for (const PassInfo& info : PassRegistry()) checks.push_back(&info);
-    RunPasses(out.program, diags, checks, false);
-  }
-  Result<std::optional<cell::Cell>> cell = cell::LoadCell(opt.cell_path, sources, diags);
-  if (!cell) {
-    PrintDiagnostics(diags, options);
-    options.exit_code = ReportIoError(cell.error());
-    return false;
-  }
-  out.cell = std::move(cell).value();
-  if (diags.has_errors() || !out.cell) {
-    options.exit_code = PrintDiagnostics(diags, options);
-    return false;
-  }
-  out.program.compile = std::make_shared<CompileState>();
-  out.program.compile->cell = &*out.cell;
-  std::vector<const PassInfo*> corrections;
-  for (const PassInfo& info : CorrectionPassRegistry()) corrections.push_back(&info);
-  RunPasses(out.program, diags, corrections, false);
-  return !diags.has_errors();
-}
 
 // Placements the compile-time trace could not place (warned), and whether
 // any Cycle places anything at all.
@@ -94,9 +55,10 @@ bool CheckTraces(const ir::Program& program, const CompileState& state, Diagnost
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  Compiled compiled;
-  if (!Compile(opt, sources, diags, compiled, options)) {
-    if (options.exit_code == kExitOk) options.exit_code = PrintDiagnostics(diags, options);
+  CompiledProgram compiled;
+  if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  if (diags.has_errors()) {
+    options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
   TruthSpec truth;
