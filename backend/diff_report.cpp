@@ -340,11 +340,11 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   svg += fmt::format("  <text x=\"{}\" y=\"28\" font-size=\"17\" font-weight=\"bold\">What moves: {} -&gt; {}</text>\n",
                      Num(kMarginPx), SvgEscape(diff.old_file), SvgEscape(diff.new_file));
   svg += fmt::format(
-      "  <text x=\"{}\" y=\"50\" fill=\"#333\">grey: unchanged targets; blue dot and arrow: a moved target, "
-      "old position to new, the arrow {} times enlarged (red: more than {} µm)</text>\n",
+      "  <text x=\"{}\" y=\"50\" fill=\"#333\">grey: unchanged; blue dot and arrow: moved, old position to new, "
+      "the arrow {} times enlarged (red: more than {} µm)</text>\n",
       Num(kMarginPx), fmt::format("{:g}", enlarge), Um(diff.threshold_um));
   svg += fmt::format(
-      "  <text x=\"{}\" y=\"68\" fill=\"#333\">green +: added target; red ×: removed target. Coordinates in mm; "
+      "  <text x=\"{}\" y=\"68\" fill=\"#333\">green +: added; red ×: removed. Coordinates in mm; "
       "{}</text>\n",
       Num(kMarginPx),
       diff.base_frame_known ? "fixture targets at the fixtures' nominal poses (--cell)"

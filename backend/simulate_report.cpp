@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/format.h>
+
+#include "backend/svg_text.h"
 
 namespace smtcal {
 namespace {
@@ -230,7 +233,8 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
       width, height, width, height);
   svg += fmt::format("<text x=\"{}\" y=\"24\" font-size=\"16\" font-weight=\"bold\">Placement error per correction "
                      "mode: {} on cell {} ({} cycles, seed {})</text>\n",
-                     kLeft, context.program, context.cell->name, result.cycles, result.options.seed);
+                     kLeft, SvgEscape(std::filesystem::path(context.program).filename().string()),
+                     SvgEscape(context.cell->name), result.cycles, result.options.seed);
   svg += fmt::format("<text x=\"{}\" y=\"46\">Each dot: one placed part, where it landed relative to where it "
                      "belongs, in µm (up to {} per mode, the same parts in every mode).</text>\n",
                      kLeft, result.options.scatter_points);
