@@ -13,6 +13,7 @@
 #include <algorithm>
 
 #include "frontend/cad_table.h"
+#include "frontend/field_text.h"
 
 namespace smtcal::cad {
 namespace {
@@ -20,12 +21,6 @@ namespace {
 // How many lines the signs are looked for in: every format's preamble is a
 // dozen lines at most.
 constexpr std::uint32_t kDetectLines = 40;
-
-std::string Lower(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
 
 std::string_view Unquote(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
@@ -74,7 +69,7 @@ std::optional<Format> DetectFormat(const Lines& lines, const SourceManager& sour
   const std::uint32_t last = std::min(lines.count(), kDetectLines);
   // A preamble's signs, wherever they are in it.
   for (std::uint32_t number = 1; number <= last; ++number) {
-    std::string lower = Lower(Unquote(lines.Text(number)));
+    std::string lower = AsciiLowercase(Unquote(lines.Text(number)));
     if ((lower.starts_with("###") && lower.find("positions") != std::string::npos) ||
         lower.starts_with("## unit") || lower.starts_with("# ref ")) {
       return Format::kKicadPos;

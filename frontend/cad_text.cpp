@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "frontend/field_text.h"
 #include "passes/tolerances.h"
 
 namespace smtcal::cad {
@@ -13,18 +14,10 @@ namespace {
 
 bool IsBlank(char c) { return c == ' ' || c == '\t'; }
 
-char LowerAscii(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
-
-std::string LowerAscii(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = LowerAscii(c);
-  return lower;
-}
-
 bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    if (LowerAscii(a[i]) != LowerAscii(b[i])) return false;
+    if (AsciiLower(a[i]) != AsciiLower(b[i])) return false;
   }
   return true;
 }
@@ -315,7 +308,7 @@ std::optional<double> ParseDecimal(std::string_view text, bool decimal_comma) {
 }  // namespace
 
 std::optional<LengthUnit> UnitFromName(std::string_view name) {
-  std::string lower = LowerAscii(Trim(name));
+  std::string lower = AsciiLowercase(Trim(name));
   if (lower == "mm") return LengthUnit::kMm;
   if (lower == "mil" || lower == "mils") return LengthUnit::kMil;
   if (lower == "in" || lower == "inch" || lower == "inches" || lower == "\"") return LengthUnit::kInch;
@@ -364,7 +357,7 @@ std::optional<double> ParseAngle(std::string_view text, bool decimal_comma) {
 }
 
 std::optional<Side> ParseSide(std::string_view text) {
-  std::string lower = LowerAscii(Trim(text));
+  std::string lower = AsciiLowercase(Trim(text));
   lower.erase(std::remove(lower.begin(), lower.end(), ' '), lower.end());
   for (std::string_view top : {"top", "t", "front", "f", "f.cu", "toplayer", "topside"}) {
     if (lower == top) return Side::kTop;
@@ -376,7 +369,7 @@ std::optional<Side> ParseSide(std::string_view text) {
 }
 
 std::optional<bool> ParseDnp(std::string_view text) {
-  std::string lower = LowerAscii(Trim(text));
+  std::string lower = AsciiLowercase(Trim(text));
   for (std::string_view yes : {"yes", "y", "true", "1", "x", "dnp", "dnf", "dni", "excluded"}) {
     if (lower == yes) return true;
   }
@@ -404,7 +397,7 @@ ColumnName NormaliseColumnName(std::string_view name) {
   }
   for (char c : name) {
     if (c == ' ' || c == '\t' || c == '-' || c == '_' || c == '.') continue;
-    column.base += LowerAscii(c);
+    column.base += AsciiLower(c);
   }
   return column;
 }
@@ -413,7 +406,7 @@ ColumnName NormaliseColumnName(std::string_view name) {
 bool GlobMatch(std::string_view pattern, std::string_view text) {
   // The common shapes first: "PREFIX*" and "*PART*" (every row of a large
   // list meets the default exclusions).
-  auto same = [](char a, char b) { return LowerAscii(a) == LowerAscii(b); };
+  auto same = [](char a, char b) { return AsciiLower(a) == AsciiLower(b); };
   if (pattern.find('?') == std::string_view::npos) {
     std::size_t stars = std::count(pattern.begin(), pattern.end(), '*');
     if (stars == 1 && pattern.back() == '*') {
@@ -438,7 +431,7 @@ bool GlobMatch(std::string_view pattern, std::string_view text) {
     } else if (p < pattern.size() && pattern[p] == '?') {
       ++p;
       t += step(t);
-    } else if (p < pattern.size() && LowerAscii(pattern[p]) == LowerAscii(text[t])) {
+    } else if (p < pattern.size() && AsciiLower(pattern[p]) == AsciiLower(text[t])) {
       ++p;
       ++t;
     } else if (star != std::string_view::npos) {

@@ -23,6 +23,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "frontend/field_text.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
 #include "passes/error_table_check.h"
@@ -47,13 +48,7 @@ constexpr std::array<std::string_view, 4> kLimitUnits = {"mm", "mm", "mm", "deg"
 // The axis words [linuxcnc] rotation_axis may name.
 constexpr std::array<std::string_view, 3> kRotationAxisNames = {"A", "B", "C"};
 
-std::string Lowercase(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
-bool SameName(std::string_view a, std::string_view b) { return Lowercase(a) == Lowercase(b); }
+bool SameName(std::string_view a, std::string_view b) { return AsciiLowercase(a) == AsciiLowercase(b); }
 
 // A user's string for a message: control characters as \xNN, so a name
 // cannot garble the terminal or the JSON output (toml++ has already refused

@@ -11,30 +11,13 @@
 #include <toml++/toml.h>
 
 #include "frontend/cad_text.h"
+#include "frontend/field_text.h"
 #include "frontend/toml_source.h"
 #include "passes/limits.h"
 #include "passes/tolerances.h"
 
 namespace smtcal::cad {
 namespace {
-
-std::string Lower(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
-std::string_view TypeName(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
-  }
-}
 
 class Reader {
  public:
@@ -82,7 +65,7 @@ class Reader {
     const toml::array* array = node->as_array();
     if (array == nullptr || !array->is_array_of_tables()) {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, fmt::format("tables written [[{}]]", key),
-                    TypeName(*node));
+                    TomlTypeName(*node));
       return tables;
     }
     for (const toml::node& item : *array) tables.push_back(item.as_table());
@@ -94,7 +77,7 @@ class Reader {
     if (node == nullptr) return std::nullopt;
     if (range != nullptr) *range = Range(*node);
     if (!node->is_string()) {
-      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a string", TypeName(*node));
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a string", TomlTypeName(*node));
       return std::nullopt;
     }
     return *node->value<std::string>();
@@ -104,7 +87,7 @@ class Reader {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_number()) {
-      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a number", TypeName(*node));
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a number", TomlTypeName(*node));
       return std::nullopt;
     }
     double value = *node->value<double>();
@@ -121,7 +104,7 @@ class Reader {
     if (node == nullptr) return std::nullopt;
     if (range != nullptr) *range = Range(*node);
     if (!node->is_integer()) {
-      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a whole number", TypeName(*node));
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a whole number", TomlTypeName(*node));
       return std::nullopt;
     }
     std::int64_t value = *node->value<std::int64_t>();
@@ -140,7 +123,7 @@ class Reader {
     if (array == nullptr || array->size() != 4 ||
         !std::all_of(array->begin(), array->end(), [](const toml::node& n) { return n.is_number(); })) {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "[x, y, z, u]: four numbers (mm, mm, mm, deg)",
-                    array == nullptr ? std::string(TypeName(*node)) : fmt::format("an array of {} items", array->size()));
+                    array == nullptr ? std::string(TomlTypeName(*node)) : fmt::format("an array of {} items", array->size()));
       return std::nullopt;
     }
     std::array<double, 4> point{};
@@ -174,7 +157,7 @@ class Reader {
         for (const toml::node& item : *list) feeder.packages.push_back(*item.value<std::string>());
       } else {
         diags_.Report(DiagKind::FeedersWrongType, Range(*package), "package",
-                      "a package name or an array of package names", TypeName(*package));
+                      "a package name or an array of package names", TomlTypeName(*package));
       }
     }
     if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
@@ -194,7 +177,7 @@ class Reader {
         }
       } else {
         diags_.Report(DiagKind::FeedersWrongType, Range(*node), "pallet",
-                      "a table { last = [x, y, z, u], back = [x, y, z, u], columns = N, rows = N }", TypeName(*node));
+                      "a table { last = [x, y, z, u], back = [x, y, z, u], columns = N, rows = N }", TomlTypeName(*node));
       }
     }
     if (diags_.error_count() != errors_before) return std::nullopt;
@@ -299,7 +282,7 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
   for (const cell::Feeder& feeder : cell_feeders) table.feeders_.push_back(FromCell(feeder));
   auto find = [&](std::string_view name) -> std::optional<std::size_t> {
     for (std::size_t i = 0; i < table.feeders_.size(); ++i) {
-      if (Lower(table.feeders_[i].name) == Lower(name)) return i;
+      if (AsciiLowercase(table.feeders_[i].name) == AsciiLowercase(name)) return i;
     }
     return std::nullopt;
   };

@@ -1,6 +1,7 @@
 // Reading and showing the text of one field of a user's file, shared by every
-// reader of CSV-like files (error tables and point lists, trip files, CAD
-// placement lists), so they accept the same numbers and print the same way.
+// reader of CSV-like and TOML files (error tables and point lists, trip
+// files, CAD placement lists, cell, feeders and truth files), so they accept
+// the same numbers, compare names the same way and print the same way.
 #pragma once
 
 #include <cstddef>
@@ -23,5 +24,10 @@ std::string Printable(std::string_view text);
 // not exactly one number; an overflow gives HUGE_VAL (so range checks report
 // it as not finite), an underflow 0.
 std::optional<double> ParseNumber(std::string_view text);
+
+// ASCII letters in lower case, every other byte as it is (names and keywords
+// in files are compared case-insensitively, whatever the user's locale).
+char AsciiLower(char c);
+std::string AsciiLowercase(std::string_view text);
 
 }  // namespace smtcal

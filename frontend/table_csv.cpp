@@ -4,8 +4,6 @@
 // out and reading goes on, so one run reports all of them.
 #include "frontend/table_csv.h"
 
-#include "frontend/field_text.h"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -21,14 +19,6 @@ namespace smtcal {
 namespace {
 
 bool IsBlank(char c) { return c == ' ' || c == '\t'; }
-
-std::string Lowercase(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
-
 
 SourceLoc At(std::uint32_t file, std::uint32_t line, std::size_t offset) {
   return SourceLoc{file, line, static_cast<std::uint32_t>(offset + 1)};
@@ -135,7 +125,7 @@ struct Header {
 bool LooksLikeHeader(const CsvRecord& record, const Schema& schema) {
   bool any_number = false;
   for (const CsvField& field : record.fields) {
-    std::string name = Lowercase(field.text);
+    std::string name = AsciiLowercase(field.text);
     for (std::string_view column : schema.columns) {
       if (name == column) return true;
     }
@@ -153,7 +143,7 @@ std::optional<Header> ReadHeader(const CsvRecord& record, const Schema& schema, 
   std::vector<std::string> suggested;  // a misspelt column is not reported missing as well
   for (std::size_t f = 0; f < record.fields.size(); ++f) {
     const CsvField& field = record.fields[f];
-    std::string name = Lowercase(field.text);
+    std::string name = AsciiLowercase(field.text);
     auto it = std::find(schema.columns.begin(), schema.columns.end(), name);
     if (name.empty()) {
       diags.Report(DiagKind::CsvEmptyColumnName, field.range);
@@ -246,7 +236,7 @@ class Row {
   std::optional<TableAxis> Axis(std::size_t column) {
     const CsvField* field = Field(column);
     if (!Present(column, field)) return std::nullopt;
-    std::string name = Lowercase(field->text);
+    std::string name = AsciiLowercase(field->text);
     if (name == "x") return TableAxis::X;
     if (name == "y") return TableAxis::Y;
     diags_.Report(DiagKind::TableBadAxis, field->range, Printable(field->text));
@@ -313,7 +303,7 @@ class Row {
 
   static std::string NumberHint(std::string_view text) {
     if (text.find(',') != std::string_view::npos) return " (write the decimal point as '.')";
-    std::string lower = Lowercase(text);
+    std::string lower = AsciiLowercase(text);
     for (std::string_view unit : {"mm", "um", "µm"}) {
       if (lower.size() > unit.size() && lower.ends_with(unit)) return " (write the number without its unit)";
     }

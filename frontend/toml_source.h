@@ -1,6 +1,6 @@
-// Locations in a TOML file for diagnostics, shared by the cell and feeders
-// loaders: toml++ counts columns in code points (after a byte order mark),
-// SourceLoc counts bytes from the start of the line.
+// Locations and type names in a TOML file for diagnostics, shared by the
+// cell, feeders and truth loaders: toml++ counts columns in code points
+// (after a byte order mark), SourceLoc counts bytes from the start of the line.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +12,19 @@
 #include "frontend/source.h"
 
 namespace smtcal {
+
+// "a string", "an integer", ...: what a value is, for "expected X, found Y".
+inline std::string_view TomlTypeName(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
 
 class TomlLocator {
  public:

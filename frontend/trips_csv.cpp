@@ -25,17 +25,11 @@ constexpr std::string_view kWhat = "a trip file";
 constexpr std::string_view kAllColumns = "name, x_mm, y_mm, z_mm";
 constexpr std::string_view kHeaderExample = "name,x_mm,y_mm,z_mm";
 
-std::string Lowercase(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
 
 
 std::string NumberHint(std::string_view text) {
   if (text.find(',') != std::string_view::npos) return " (write the decimal point as '.')";
-  const std::string lower = Lowercase(text);
+  const std::string lower = AsciiLowercase(text);
   if (lower.size() > 2 && (lower.ends_with("mm") || lower.ends_with("um"))) {
     return " (write the number without its unit)";
   }
@@ -61,7 +55,7 @@ std::optional<Header> ReadHeader(const CsvRecord& record, Diagnostics& diags) {
   const std::vector<std::string> known(kColumns.begin(), kColumns.end());
   for (std::size_t f = 0; f < record.fields.size(); ++f) {
     const CsvField& field = record.fields[f];
-    const std::string name = Lowercase(field.text);
+    const std::string name = AsciiLowercase(field.text);
     if (name.empty()) {
       diags.Report(DiagKind::CsvEmptyColumnName, field.range);
       ok = false;
@@ -105,7 +99,7 @@ bool LooksLikeHeader(const CsvRecord& record) {
   bool any_number = false;
   for (const CsvField& field : record.fields) {
     for (std::string_view column : kColumns) {
-      if (Lowercase(field.text) == column) return true;
+      if (AsciiLowercase(field.text) == column) return true;
     }
     if (ParseNumber(field.text)) any_number = true;
   }

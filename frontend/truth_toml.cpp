@@ -17,24 +17,6 @@
 namespace smtcal {
 namespace {
 
-std::string Lower(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
-std::string_view TypeName(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
-  }
-}
-
 // 'a', 'b' and 'c' (or: 'a', 'b' or 'c').
 std::string Listed(const std::vector<std::string>& names, std::string_view last = " and ") {
   std::string text;
@@ -129,7 +111,7 @@ class Reader {
       return;
     }
     for (const TruthRegionTable& given : spec.region_tables) {
-      if (Lower(given.region) != Lower(region->name)) continue;
+      if (AsciiLowercase(given.region) != AsciiLowercase(region->name)) continue;
       diags_.Report(DiagKind::TruthDuplicateRegion, name_range, region->name, given.range.begin.line);
       return;
     }
@@ -160,7 +142,7 @@ class Reader {
     if (node == nullptr) return nullptr;
     if (!node->is_table()) {
       diags_.Report(DiagKind::TruthWrongType, Range(*node), key, fmt::format("a table written [{}]", key),
-                    TypeName(*node));
+                    TomlTypeName(*node));
       return nullptr;
     }
     return node->as_table();
@@ -173,7 +155,7 @@ class Reader {
     const toml::array* array = node->as_array();
     if (array == nullptr || !array->is_array_of_tables()) {
       diags_.Report(DiagKind::TruthWrongType, Range(*node), key, fmt::format("tables written [[{}]]", key),
-                    TypeName(*node));
+                    TomlTypeName(*node));
       return tables;
     }
     for (const toml::node& item : *array) tables.push_back(item.as_table());
@@ -184,7 +166,7 @@ class Reader {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_boolean()) {
-      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "true or false", TypeName(*node));
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "true or false", TomlTypeName(*node));
       return std::nullopt;
     }
     return *node->value<bool>();
@@ -195,7 +177,7 @@ class Reader {
     if (node == nullptr) return std::nullopt;
     if (range != nullptr) *range = Range(*node);
     if (!node->is_string()) {
-      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "a string", TypeName(*node));
+      diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "a string", TomlTypeName(*node));
       return std::nullopt;
     }
     return *node->value<std::string>();
@@ -217,7 +199,7 @@ class Reader {
   std::optional<double> NumberOf(const toml::node& node, std::string_view key, double lo, double hi,
                                  std::string_view unit) {
     if (!node.is_number()) {
-      diags_.Report(DiagKind::TruthWrongType, Range(node), key, "a number", TypeName(node));
+      diags_.Report(DiagKind::TruthWrongType, Range(node), key, "a number", TomlTypeName(node));
       return std::nullopt;
     }
     const double value = *node.value<double>();
@@ -244,7 +226,7 @@ class Reader {
     const toml::array* array = node->as_array();
     if (array == nullptr || array->size() != 2) {
       diags_.Report(DiagKind::TruthWrongType, Range(*node), key, "[x, y]: two numbers in mm",
-                    array == nullptr ? std::string(TypeName(*node)) : fmt::format("an array of {} items", array->size()));
+                    array == nullptr ? std::string(TomlTypeName(*node)) : fmt::format("an array of {} items", array->size()));
       return std::nullopt;
     }
     std::optional<double> x = NumberOf(*array->get(0), key, -limit, limit, "mm");

@@ -19,17 +19,12 @@
 #include <fmt/format.h>
 
 #include "frontend/cad_text.h"
+#include "frontend/field_text.h"
 #include "passes/limits.h"
 #include "passes/tolerances.h"
 
 namespace smtcal {
 namespace {
-
-std::string Lower(std::string_view text) {
-  std::string lower(text);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
 
 // The .place keywords (docs/language.md, "Lexical rules"); a name may not be one.
 constexpr std::string_view kKeywords[] = {
@@ -39,7 +34,7 @@ constexpr std::string_view kKeywords[] = {
     "step",  "sw",    "taught", "then",  "to",     "units",    "vacuum",  "wait",  "xor",   "xy"};
 
 bool IsKeyword(std::string_view name) {
-  std::string lower = Lower(name);
+  std::string lower = AsciiLowercase(name);
   return std::find(std::begin(kKeywords), std::end(kKeywords), lower) != std::end(kKeywords);
 }
 
@@ -82,7 +77,7 @@ double NormaliseAngle(double degrees, AngleRange range) {
 
 // Values and packages that mean "do not place" (any case).
 bool IsDnpValue(std::string_view value) {
-  std::string lower = Lower(value);
+  std::string lower = AsciiLowercase(value);
   for (std::string_view mark : {"dnp", "dnf", "dni", "nf", "np", "nopop", "no pop", "do not place",
                                 "do not populate", "do not fit", "not fitted", "not populated"}) {
     if (lower == mark) return true;
@@ -175,16 +170,16 @@ class NameTable {
     NameOwner owner;
   };
 
-  static char Lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+  static char AsciiLowercase(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
   static std::size_t Hash(std::string_view name) {
     std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
-    for (char c : name) hash = (hash ^ static_cast<unsigned char>(Lower(c))) * 1099511628211ull;
+    for (char c : name) hash = (hash ^ static_cast<unsigned char>(AsciiLowercase(c))) * 1099511628211ull;
     return static_cast<std::size_t>(hash);
   }
   static bool Same(std::string_view a, std::string_view b) {
     if (a.size() != b.size()) return false;
     for (std::size_t i = 0; i < a.size(); ++i) {
-      if (Lower(a[i]) != Lower(b[i])) return false;
+      if (AsciiLowercase(a[i]) != AsciiLowercase(b[i])) return false;
     }
     return true;
   }
@@ -569,7 +564,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       // Equal designators make equal names, so a duplicate shows as a
       // collision with the point of the same designator.
       if (b == 0 && taken) {
-        if (taken->what == "the point of" && Lower(taken->name) == Lower(part.designator)) {
+        if (taken->what == "the point of" && AsciiLowercase(taken->name) == AsciiLowercase(part.designator)) {
           diags_.Report(DiagKind::ImportDuplicateDesignator, part.designator_range, Printable(part.designator),
                         taken->line, name);
         } else {

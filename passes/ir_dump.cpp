@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "frontend/field_text.h"
 #include "passes/ir_ops.h"
 
 namespace smtcal {
@@ -48,12 +49,6 @@ std::string Number(double value) { return fmt::format("{}", value); }
 
 // Operators and axes print as the language spells them, in lower case like
 // every head word of the dump: (+ a b), (mod a b), (and a b), (+x d).
-std::string Lower(std::string_view spelling) {
-  std::string lower(spelling);
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return lower;
-}
-
 // Unary operators get words of their own, so (neg a) never reads as a
 // binary minus.
 std::string_view UnaryName(ir::UnaryOp op) {
@@ -107,7 +102,7 @@ class Dumper {
     return fmt::format("({}{} {})", UnaryName(u.op), at, Expr(u.operand));
   }
   std::string ExprNode(const ir::BinaryExpr& b, const std::string& at) {
-    return fmt::format("({}{} {} {})", Lower(ir::BinaryOpSpelling(b.op)), at, Expr(b.lhs), Expr(b.rhs));
+    return fmt::format("({}{} {} {})", AsciiLowercase(ir::BinaryOpSpelling(b.op)), at, Expr(b.lhs), Expr(b.rhs));
   }
   std::string ExprNode(const ir::SwitchRead& s, const std::string& at) {
     return fmt::format("(sw{} {})", at, Expr(s.bit));
@@ -131,7 +126,7 @@ class Dumper {
       out += ")";
     }
     for (const ir::PointOffset& offset : p.offsets) {
-      out += fmt::format(" ({}{}{} {})", offset.negative ? '-' : '+', Lower(ir::AxisSpelling(offset.axis)),
+      out += fmt::format(" ({}{}{} {})", offset.negative ? '-' : '+', AsciiLowercase(ir::AxisSpelling(offset.axis)),
                          Loc(offset.loc), Expr(offset.amount));
     }
     return out + ")";
@@ -223,12 +218,12 @@ class Dumper {
     Simple("assign", at, " " + NameAtom(a.name) + " " + Expr(a.value), s);
   }
   void StmtNode(const ir::Motion& m, const ir::Stmt& s, const std::string& at, int) {
-    std::string head = Lower(ir::MotionSpelling(m.kind));
+    std::string head = AsciiLowercase(ir::MotionSpelling(m.kind));
     std::string limz = m.limz ? fmt::format(" :limz{} {}", Loc(m.limz_loc), Expr(m.limz)) : std::string();
     Simple(head, at, " " + Point(m.target) + limz, s);
   }
   void StmtNode(const ir::PickPlace& p, const ir::Stmt& s, const std::string& at, int) {
-    Simple(Lower(ir::PickPlaceSpelling(p.kind)), at,
+    Simple(AsciiLowercase(ir::PickPlaceSpelling(p.kind)), at,
            " " + Point(p.target) + Optional("vacuum", p.vacuum) + Optional("limz", p.limz), s);
   }
   void StmtNode(const ir::SetOutput& o, const ir::Stmt& s, const std::string& at, int) {
