@@ -5,8 +5,9 @@
 // file that is not *.out, *.err, *.args or ARGS is a case. The harness runs
 // smtcal in the suite folder and compares stdout with <case>.out and stderr
 // with <case>.err (a missing file means "expected empty"). A case named
-// fail_* must exit 1; every other case must exit 0. <case>.args overrides
-// ARGS for one case.
+// fail_* must exit 1; every other case must exit 0, unless <case>.exit holds
+// the exit code it must give (a gate such as `smtcal diff` exits 1 on clean
+// input). <case>.args overrides ARGS for one case.
 //
 // SMTCAL_UPDATE_GOLDEN=1 rewrites the expectations instead of comparing, so a
 // reviewer reads the change as a diff.
@@ -56,7 +57,7 @@ std::string Trim(std::string text) {
 
 bool IsExpectation(const fs::path& path) {
   std::string ext = path.extension().string();
-  return ext == ".out" || ext == ".err" || ext == ".args" || path.filename() == "ARGS" ||
+  return ext == ".out" || ext == ".err" || ext == ".args" || ext == ".exit" || path.filename() == "ARGS" ||
          path.filename().string().rfind('.', 0) == 0;  // hidden files, editor leftovers
 }
 
@@ -112,7 +113,11 @@ TEST_P(GoldenFiles, MatchesExpectedOutput) {
   ASSERT_NE(run.exit_code, -1) << run.command;
 
   bool must_fail = c.input.rfind("fail_", 0) == 0;
-  EXPECT_EQ(run.exit_code, must_fail ? 1 : 0) << "command: " << run.command << "\nstderr:\n" << run.err;
+  int expected_exit = must_fail ? 1 : 0;
+  if (fs::path exit_file = stem.string() + ".exit"; fs::exists(exit_file)) {
+    expected_exit = std::stoi(Trim(ReadFileText(exit_file)));
+  }
+  EXPECT_EQ(run.exit_code, expected_exit) << "command: " << run.command << "\nstderr:\n" << run.err;
 
   fs::path expected_out = stem.string() + ".out";
   fs::path expected_err = stem.string() + ".err";
