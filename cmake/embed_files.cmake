@@ -1,5 +1,5 @@
 # Writes a C++ source that holds the text of each file in FILES (a ;-list) as
-# a string literal, for backend/embedded_files.h. Run at build time:
+# a string literal, for backend/linuxcnc/embedded_files.h. Run at build time:
 #   cmake -DOUT=file.cpp -DFILES="a;b" -DFUNCTION=Name -P embed_files.cmake
 # Each file's text is split into raw-string pieces of at most 8000 bytes
 # (compilers only promise 65 535 bytes per literal) and joined at run time.
@@ -28,7 +28,7 @@ file(WRITE "${OUT}.tmp"
 #include <string_view>
 #include <vector>
 
-#include \"backend/embedded_files.h\"
+#include \"backend/linuxcnc/embedded_files.h\"
 
 namespace smtcal {
 namespace {

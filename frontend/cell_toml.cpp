@@ -8,7 +8,7 @@
 // of them. Checks that combine several values (marker geometry, scan trips,
 // region overlap, robot limits) run only on the parts that were read cleanly,
 // so one typo does not cascade into a page of follow-up errors.
-#include "frontend/cell.h"
+#include "frontend/cell_toml.h"
 
 #include <algorithm>
 #include <cctype>
@@ -23,24 +23,17 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
-#include "frontend/field_text.h"
+#include "base/field_text.h"
+#include "calibration/error_table_check.h"
+#include "calibration/fixture_geometry.h"
+#include "calibration/limits.h"
+#include "calibration/tolerances.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
-#include "passes/error_table_check.h"
-#include "passes/fixture_geometry.h"
-#include "passes/limits.h"
-#include "passes/tolerances.h"
 
 namespace smtcal::cell {
 namespace {
 
-// The names as the file writes them, in the order of their enums.
-constexpr std::array<std::string_view, 4> kTaskAxisNames = {"x", "y", "z", "u"};
-static_assert(static_cast<int>(TaskAxis::U) == 3);
-constexpr std::array<std::string_view, 3> kEstimatorNames = {"paper", "rigid", "rigid-scale"};
-static_assert(static_cast<int>(Estimator::kRigidScale) == 2);
-constexpr std::array<std::string_view, 3> kOutsideNames = {"error", "clamp", "none"};
-static_assert(static_cast<int>(OutsidePolicy::kClamp) == 1 && static_cast<int>(OutsidePolicy::kNone) == 2);
 constexpr std::array<std::string_view, 4> kEdgeNames = {"p1", "p2", "p3", "p4"};
 // The robot's limits, in the order of Robot::limits.
 constexpr std::array<std::string_view, 4> kLimitKeys = {"x_mm", "y_mm", "z_mm", "u_deg"};
@@ -831,7 +824,7 @@ bool Loader::CheckMarkerGeometry(const Fixture& fixture, Keys& keys) {
 }
 
 // Every edge's line is fitted through its trips: it needs two different ones.
-// The trips are those the estimator expects (passes/fixture_geometry.h), so
+// The trips are those the estimator expects (calibration/fixture_geometry.h), so
 // the loader and the runtime agree on T1..Tn.
 bool Loader::CheckScanTrips(const Fixture& fixture) {
   std::vector<ExpectedTrip> trips = ExpectedTrips(fixture);
@@ -1111,34 +1104,6 @@ std::string ParseErrorText(std::string_view description) {
 
 // ------------------------------------------------------------------ public
 
-const Fixture* Cell::FindFixture(std::string_view name) const {
-  for (const Fixture& fixture : fixtures) {
-    if (SameName(fixture.name, name)) return &fixture;
-  }
-  return nullptr;
-}
-
-const Region* Cell::FindRegion(std::string_view name) const {
-  for (const Region& region : regions) {
-    if (SameName(region.name, name)) return &region;
-  }
-  return nullptr;
-}
-
-const Feeder* Cell::FindFeeder(std::string_view name) const {
-  for (const Feeder& feeder : feeders) {
-    if (SameName(feeder.name, name)) return &feeder;
-  }
-  return nullptr;
-}
-
-const Region* Cell::RegionAt(const Point2& p) const {
-  for (const Region& region : regions) {
-    if (region.Contains(p)) return &region;
-  }
-  return nullptr;
-}
-
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags) {
   Result<std::uint32_t> file = sources.Load(path);
   if (!file) return file.error();
@@ -1155,9 +1120,5 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
   }
   return loader.Load(root, path);
 }
-
-std::string_view EstimatorName(Estimator estimator) { return kEstimatorNames[static_cast<std::size_t>(estimator)]; }
-std::string_view TaskAxisName(TaskAxis axis) { return kTaskAxisNames[static_cast<std::size_t>(axis)]; }
-std::string_view OutsidePolicyName(OutsidePolicy policy) { return kOutsideNames[static_cast<std::size_t>(policy)]; }
 
 }  // namespace smtcal::cell

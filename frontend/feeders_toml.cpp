@@ -10,11 +10,11 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
-#include "frontend/cad_text.h"
-#include "frontend/field_text.h"
+#include "base/field_text.h"
+#include "calibration/limits.h"
+#include "calibration/tolerances.h"
+#include "frontend/cad/cad_text.h"
 #include "frontend/toml_source.h"
-#include "passes/limits.h"
-#include "passes/tolerances.h"
 
 namespace smtcal::cad {
 namespace {

@@ -30,10 +30,10 @@
 #include <string>
 #include <vector>
 
-#include "frontend/cad_row.h"
-#include "frontend/cell.h"
-#include "frontend/diagnostics.h"
-#include "frontend/result.h"
+#include "base/diagnostics.h"
+#include "base/result.h"
+#include "calibration/cell.h"
+#include "frontend/cad/cad_row.h"
 
 namespace smtcal::cad {
 

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "frontend/diagnostics.h"
-#include "passes/ir.h"
+#include "base/diagnostics.h"
+#include "ir/ir.h"
 
 namespace smtcal {
 

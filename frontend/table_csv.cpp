@@ -11,9 +11,9 @@
 
 #include <fmt/format.h>
 
-#include "frontend/check.h"
-#include "frontend/field_text.h"
-#include "passes/tolerances.h"
+#include "base/check.h"
+#include "base/field_text.h"
+#include "calibration/tolerances.h"
 
 namespace smtcal {
 namespace {

@@ -9,7 +9,7 @@
 // leave it out: then the columns are x_mm,y_mm); a column smtcal does not know
 // is an error naming it. Numbers are read locale-independently ('.' decimal
 // point, optional exponent); nan, inf and lengths beyond kMaxLengthMm
-// (passes/tolerances.h) are rejected.
+// (calibration/tolerances.h) are rejected.
 #pragma once
 
 #include <cstdint>
@@ -19,9 +19,9 @@
 
 #include <Eigen/Core>
 
-#include "frontend/diagnostics.h"
-#include "passes/error_table.h"
-#include "passes/error_table_build.h"
+#include "base/diagnostics.h"
+#include "calibration/error_table.h"
+#include "calibration/error_table_build.h"
 
 namespace smtcal {
 

@@ -8,8 +8,8 @@
 
 #include <toml++/toml.h>
 
-#include "frontend/diagnostics.h"
-#include "frontend/source.h"
+#include "base/diagnostics.h"
+#include "base/source.h"
 
 namespace smtcal {
 

@@ -11,9 +11,9 @@
 
 #include <fmt/format.h>
 
-#include "frontend/field_text.h"
+#include "base/field_text.h"
+#include "calibration/tolerances.h"
 #include "frontend/table_csv.h"
-#include "passes/tolerances.h"
 
 namespace smtcal {
 namespace {

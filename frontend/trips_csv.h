@@ -20,7 +20,7 @@
 
 #include <Eigen/Core>
 
-#include "frontend/diagnostics.h"
+#include "base/diagnostics.h"
 
 namespace smtcal {
 

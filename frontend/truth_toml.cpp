@@ -9,10 +9,10 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
-#include "frontend/field_text.h"
+#include "base/field_text.h"
+#include "calibration/error_table_check.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
-#include "passes/error_table_check.h"
 
 namespace smtcal {
 namespace {

@@ -8,11 +8,11 @@
 #include <optional>
 #include <string>
 
-#include "frontend/cell.h"
-#include "frontend/diagnostics.h"
-#include "frontend/result.h"
-#include "frontend/source.h"
-#include "passes/sim_truth.h"
+#include "base/diagnostics.h"
+#include "base/result.h"
+#include "base/source.h"
+#include "calibration/cell.h"
+#include "calibration/truth_spec.h"
 
 namespace smtcal {
 

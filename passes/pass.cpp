@@ -5,11 +5,11 @@
 
 #include <fmt/format.h>
 
-#include "passes/checks.h"
-#include "passes/correction_passes.h"
+#include "ir/verifier.h"
+#include "passes/checks/checks.h"
+#include "passes/correction/correction_passes.h"
 #include "passes/pass.h"
 #include "passes/pass_manager.h"
-#include "passes/verifier.h"
 
 namespace smtcal {
 

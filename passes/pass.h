@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "frontend/diagnostics.h"
-#include "passes/ir.h"
+#include "base/diagnostics.h"
+#include "ir/ir.h"
 
 namespace smtcal {
 

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "frontend/diagnostics.h"
-#include "frontend/result.h"
-#include "passes/ir.h"
+#include "base/diagnostics.h"
+#include "base/result.h"
+#include "ir/ir.h"
 #include "passes/pass.h"
 
 namespace smtcal {

@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "frontend/cell.h"
-#include "passes/fixture_geometry.h"
+#include "calibration/fixture_geometry.h"
+#include "frontend/cell_toml.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

@@ -3,14 +3,14 @@
 // program, verify only reports.
 #include <fmt/core.h>
 
-#include "backend/c_data.h"
-#include "backend/compile_report.h"
-#include "backend/linuxcnc_emit.h"
-#include "backend/place_printer.h"
-#include "frontend/cell.h"
+#include "backend/c/c_data.h"
+#include "backend/linuxcnc/linuxcnc_emit.h"
+#include "backend/place/place_printer.h"
+#include "backend/reports/compile_report.h"
+#include "calibration/cell.h"
 #include "frontend/parse.h"
-#include "passes/compile_state.h"
-#include "passes/correction_passes.h"
+#include "passes/correction/compile_state.h"
+#include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
 #include "tools/commands.h"
 #include "tools/compile_pipeline.h"

@@ -4,11 +4,12 @@
 // JSON, SVG); this file only wires files, options and exit codes.
 #include <fmt/core.h>
 
-#include "backend/diff_report.h"
-#include "backend/program_diff.h"
+#include "backend/diff/diff_report.h"
+#include "backend/diff/program_diff.h"
+#include "calibration/tolerances.h"
+#include "frontend/cell_toml.h"
 #include "frontend/parse.h"
 #include "passes/pass_manager.h"
-#include "passes/tolerances.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

@@ -10,9 +10,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "frontend/cell.h"
+#include "calibration/fixture_estimation.h"
+#include "frontend/cell_toml.h"
 #include "frontend/trips_csv.h"
-#include "passes/fixture_estimation.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

@@ -2,9 +2,9 @@
 // "Canonical form"). Only parses; the semantic checks are `smtcal check`.
 #include <fmt/core.h>
 
-#include "backend/place_printer.h"
+#include "backend/place/place_printer.h"
 #include "frontend/parse.h"
-#include "passes/ir_dump.h"
+#include "ir/ir_dump.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

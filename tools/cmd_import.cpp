@@ -9,14 +9,14 @@
 
 #include <fmt/core.h>
 
-#include "backend/place_printer.h"
-#include "frontend/cad_reader.h"
-#include "frontend/cad_text.h"
-#include "frontend/cell.h"
+#include "backend/place/place_printer.h"
+#include "calibration/limits.h"
+#include "calibration/tolerances.h"
+#include "frontend/cad/cad_reader.h"
+#include "frontend/cad/cad_text.h"
+#include "frontend/cad/cad_to_program.h"
+#include "frontend/cell_toml.h"
 #include "frontend/feeders_toml.h"
-#include "passes/cad_to_program.h"
-#include "passes/limits.h"
-#include "passes/tolerances.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

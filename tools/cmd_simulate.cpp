@@ -1,19 +1,19 @@
 // smtcal simulate: a .place program compiled for a cell (the checks and the
 // correction passes of `smtcal compile`), then run on the virtual cell
-// (passes/virtual_cell.h) in six correction modes on the same random draws;
+// (simulation/virtual_cell.h) in six correction modes on the same random draws;
 // prints the placement accuracy per mode (docs/simulate.md).
 #include <fmt/core.h>
 
-#include "backend/compile_report.h"
-#include "backend/simulate_report.h"
-#include "frontend/cell.h"
+#include "backend/reports/compile_report.h"
+#include "backend/reports/simulate_report.h"
+#include "calibration/cell.h"
 #include "frontend/parse.h"
 #include "frontend/truth_toml.h"
-#include "passes/compile_state.h"
-#include "passes/correction_passes.h"
+#include "ir/symbols.h"
+#include "passes/correction/compile_state.h"
+#include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
-#include "passes/symbols.h"
-#include "passes/virtual_cell.h"
+#include "simulation/virtual_cell.h"
 #include "tools/commands.h"
 #include "tools/compile_pipeline.h"
 

@@ -5,12 +5,12 @@
 #include <filesystem>
 #include <optional>
 
-#include "backend/table_plot.h"
-#include "backend/table_report.h"
+#include "backend/reports/table_plot.h"
+#include "backend/reports/table_report.h"
+#include "calibration/error_table_build.h"
+#include "calibration/error_table_check.h"
+#include "calibration/inverse_calibration.h"
 #include "frontend/table_csv.h"
-#include "passes/error_table_build.h"
-#include "passes/error_table_check.h"
-#include "passes/inverse_calibration.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {

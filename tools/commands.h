@@ -6,8 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "frontend/diagnostics.h"
-#include "frontend/result.h"
+#include "base/diagnostics.h"
+#include "base/result.h"
 
 namespace smtcal::tools {
 

@@ -33,7 +33,7 @@ else
 fi
 
 # A decimal-comma locale, so the tests can show that reading numbers does not
-# depend on the user's locale (tests/unit/table_csv_test.cpp).
+# depend on the user's locale (tests/unit/frontend/table_csv_test.cpp).
 if ! locale -a 2>/dev/null | grep -qi '^de_DE\.utf-\?8$'; then
   if [ "$(id -u)" -eq 0 ]; then
     sed -i 's/^# *de_DE.UTF-8 UTF-8/de_DE.UTF-8 UTF-8/' /etc/locale.gen

@@ -42,11 +42,11 @@
 
 #include <fmt/format.h>
 
-#include "backend/table_plot.h"
-#include "backend/table_report.h"
+#include "backend/reports/table_plot.h"
+#include "backend/reports/table_report.h"
+#include "calibration/error_table_build.h"
+#include "calibration/error_table_check.h"
 #include "frontend/table_csv.h"
-#include "passes/error_table_build.h"
-#include "passes/error_table_check.h"
 
 namespace smtcal {
 namespace {

@@ -3,9 +3,9 @@
  * smtcal_runtime.h for the API and docs/periphery.md for the math).
  *
  * Every step mirrors smtcal's C++ implementation in the same order
- * (passes/fixture_estimation.cpp for the scan, passes/error_table.cpp and
- * passes/inverse_calibration.cpp for the tables), so the two agree to
- * rounding; tests/unit/fixture_c_runtime_test.cpp holds them within 1e-9 mm.
+ * (calibration/fixture_estimation.cpp for the scan, calibration/error_table.cpp and
+ * calibration/inverse_calibration.cpp for the tables), so the two agree to
+ * rounding; tests/unit/backend/fixture_c_runtime_test.cpp holds them within 1e-9 mm.
  * No heap, no writable globals, fixed arrays, only sqrt and atan2 from libm.
  */
 #include "smtcal_runtime.h"
@@ -116,7 +116,7 @@ static void region_delta(const smtcal_region *r, const double n[2], double delta
 
 static double inf_norm(const double v[2]) { return max_d(abs_d(v[0]), abs_d(v[1])); }
 
-/* The default inverse solver of passes/inverse_calibration.cpp: Newton on
+/* The default inverse solver of calibration/inverse_calibration.cpp: Newton on
  * F(n) - a, a step kept only when it shrinks the residual at least as much
  * as the contracting fixed-point step n <- a - Delta(n), which is taken
  * otherwise; at most iteration_bound iterations. */
@@ -363,7 +363,7 @@ static int paper_fix(const smtcal_fixture *fx, const double trips[][2], smtcal_f
 }
 
 /* The rigid and rigid-scale least squares (derivation in
- * passes/fixture_estimation.cpp and docs/periphery.md): in the nominal
+ * calibration/fixture_estimation.cpp and docs/periphery.md): in the nominal
  * fixture frame, eliminate the translation, solve Q u = g for
  * u = (cos, sin) / scale, and for rigid move u along the unit circle by
  * Newton steps. */

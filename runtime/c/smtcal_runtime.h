@@ -17,7 +17,7 @@
  *
  * Units: mm and degrees in the data and the results. Documented in
  * runtime/c/README.md and docs/periphery.md; the C++ implementation it is
- * tested against is passes/fixture_estimation.h.
+ * tested against is calibration/fixture_estimation.h.
  */
 #ifndef SMTCAL_RUNTIME_H
 #define SMTCAL_RUNTIME_H
@@ -31,7 +31,7 @@ extern "C" {
 #define SMTCAL_EDGE_COUNT 4 /* marker edges p1..p4 */
 #define SMTCAL_CHECK_COUNT 11
 
-/* Tolerances; the same values as smtcal's passes/tolerances.h. */
+/* Tolerances; the same values as smtcal's calibration/tolerances.h. */
 #define SMTCAL_MIN_TRIP_SEPARATION_MM 0.01
 #define SMTCAL_MIN_LINE_CROSSING_SIN 0.1
 #define SMTCAL_MIN_RELATIVE_DETERMINANT 1e-12

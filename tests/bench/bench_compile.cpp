@@ -6,13 +6,10 @@
 
 #include <fmt/format.h>
 
-#include "backend/linuxcnc_emit.h"
-#include "backend/place_printer.h"
-#include "frontend/cell.h"
-#include "frontend/parse.h"
-#include "passes/compile_state.h"
-#include "passes/correction_passes.h"
-#include "passes/pass_manager.h"
+#include "backend/linuxcnc/linuxcnc_emit.h"
+#include "backend/place/place_printer.h"
+#include "passes/compile_pipeline.h"
+#include "passes/correction/compile_state.h"
 #include "tests/bench/bench_support.h"
 
 namespace smtcal {
@@ -52,18 +49,13 @@ void BM_Compile100kPlacements(benchmark::State& state) {
     SourceManager sources;
     std::uint32_t file = sources.Add("bench.place", text);
     Diagnostics diags(sources);
-    ir::Program program = ParseProgram(file, diags);
-    Status checked = RunPasses(program, diags, std::vector<std::string>{}, false);
-    Result<std::optional<cell::Cell>> cell = cell::LoadCell(cell_path, sources, diags);
-    if (!checked || !cell || !cell.value()) {
+    CompiledProgram compiled;
+    Result<bool> ran = CompileForCell(file, cell_path, false, sources, diags, compiled);
+    if (!ran || !ran.value()) {
       state.SkipWithError("the generated program or the paper cell does not load");
       return;
     }
-    program.compile = std::make_shared<CompileState>();
-    program.compile->cell = &*cell.value();
-    std::vector<const PassInfo*> passes;
-    for (const PassInfo& info : CorrectionPassRegistry()) passes.push_back(&info);
-    RunPasses(program, diags, passes, false);
+    const ir::Program& program = compiled.program;
     std::string corrected;
     if (linuxcnc) {
       std::optional<LinuxCncOutput> output = EmitLinuxCnc(program, *program.compile, "bench.place", diags);

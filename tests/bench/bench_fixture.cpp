@@ -28,11 +28,11 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include "backend/c_data.h"
-#include "frontend/cell.h"
-#include "passes/fixture_estimation.h"
+#include "backend/c/c_data.h"
+#include "calibration/fixture_estimation.h"
+#include "frontend/cell_toml.h"
 #include "runtime/c/smtcal_runtime.h"
-#include "tests/unit/fixture_test_cell.h"
+#include "tests/unit/calibration/fixture_test_cell.h"
 
 namespace smtcal {
 namespace {

@@ -8,10 +8,10 @@
 
 #include <fmt/format.h>
 
-#include "backend/place_printer.h"
-#include "frontend/cad_reader.h"
+#include "backend/place/place_printer.h"
+#include "frontend/cad/cad_reader.h"
+#include "frontend/cad/cad_to_program.h"
 #include "frontend/feeders_toml.h"
-#include "passes/cad_to_program.h"
 #include "tests/bench/bench_support.h"
 
 namespace smtcal {

@@ -10,9 +10,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include "calibration/error_table_check.h"
+#include "calibration/inverse_calibration.h"
 #include "frontend/table_csv.h"
-#include "passes/error_table_check.h"
-#include "passes/inverse_calibration.h"
 
 namespace smtcal {
 namespace {

@@ -8,12 +8,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "frontend/cell.h"
-#include "frontend/parse.h"
-#include "passes/compile_state.h"
-#include "passes/correction_passes.h"
-#include "passes/pass_manager.h"
-#include "passes/virtual_cell.h"
+#include "passes/compile_pipeline.h"
+#include "passes/correction/compile_state.h"
+#include "simulation/virtual_cell.h"
 
 namespace smtcal {
 namespace {
@@ -22,26 +19,18 @@ void BM_SimulatePaperCell(benchmark::State& state) {
   SourceManager sources;
   Diagnostics diags(sources);
   Result<std::uint32_t> file = sources.Load(SMTCAL_SOURCE_DIR "/examples/paper-cell/layers.place");
-  Result<std::optional<cell::Cell>> cell =
-      cell::LoadCell(SMTCAL_SOURCE_DIR "/examples/paper-cell/paper.cell.toml", sources, diags);
-  if (!file || !cell || !cell.value()) {
+  if (!file) {
     state.SkipWithError("the paper cell example does not load");
     return;
   }
-  ir::Program program = ParseProgram(file.value(), diags);
-  if (!RunPasses(program, diags, std::vector<std::string>{}, false)) {
-    state.SkipWithError("the checks did not run");
-    return;
-  }
-  program.compile = std::make_shared<CompileState>();
-  program.compile->cell = &*cell.value();
-  std::vector<const PassInfo*> passes;
-  for (const PassInfo& info : CorrectionPassRegistry()) passes.push_back(&info);
-  RunPasses(program, diags, passes, false);
-  if (diags.has_errors()) {
+  CompiledProgram compiled;
+  Result<bool> ran = CompileForCell(file.value(), SMTCAL_SOURCE_DIR "/examples/paper-cell/paper.cell.toml", false,
+                                    sources, diags, compiled);
+  if (!ran || !ran.value() || diags.has_errors()) {
     state.SkipWithError("the paper cell example does not compile");
     return;
   }
+  const ir::Program& program = compiled.program;
   SimOptions options;
   options.cycles = static_cast<int>(state.range(0));
   options.seed = 19940101;

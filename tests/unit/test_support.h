@@ -1,5 +1,5 @@
-// Helpers shared by the tests: parsing a text, reading a file, and running
-// the real smtcal executable the way a user does.
+// Helpers shared by the tests: reading a file, and running the real smtcal
+// executable the way a user does. (Parsing a text: tests/unit/parse_text.h.)
 #pragma once
 
 #include <sys/wait.h>
@@ -15,30 +15,8 @@
 
 #include <fmt/core.h>
 
-#include "frontend/diagnostics.h"
-#include "frontend/parse.h"
-#include "passes/ir.h"
 
 namespace smtcal::test {
-
-// A .place text parsed on its own, registered as "t.place".
-struct ParsedText {
-  ir::Program program;
-  std::string diagnostics;  // RenderText of every diagnostic
-  std::size_t error_count = 0;
-  bool ok() const { return error_count == 0; }
-};
-
-inline ParsedText ParseText(const std::string& text) {
-  SourceManager sources;
-  std::uint32_t file = sources.Add("t.place", text);
-  Diagnostics diags(sources);
-  ParsedText parsed;
-  parsed.program = ParseProgram(file, diags);
-  parsed.diagnostics = diags.RenderText();
-  parsed.error_count = diags.error_count();
-  return parsed;
-}
 
 // The whole file as bytes; empty if it cannot be read.
 inline std::string ReadFileText(const std::filesystem::path& path) {

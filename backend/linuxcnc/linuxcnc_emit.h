@@ -1,0 +1,58 @@
+// The LinuxCNC target: a compiled program (the IR after the correction passes
+// and their CompileState) lowered to RS274NGC for LinuxCNC's interpreter,
+// and the output directory that holds it with the runtime subroutines
+// (docs/linuxcnc.md has the lowering table, the directory and the checks).
+//
+// The main program calls the runtime (runtime/linuxcnc/*.ngc) for
+// everything that happens on the controller: loading the cell's data, the
+// marker scan and the correction of fixture and run-time targets. Static
+// targets are the nominal coordinates the passes computed.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "backend/linuxcnc/embedded_files.h"
+#include "base/diagnostics.h"
+#include "base/result.h"
+#include "base/source.h"
+#include "ir/ir.h"
+#include "passes/correction/compile_state.h"
+
+namespace smtcal {
+
+// What one compile writes: the main program and the subroutine files.
+struct LinuxCncOutput {
+  std::string main_name;                  // "<program file stem>.ngc"
+  std::string main_text;
+  std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
+};
+
+// Lowers the program. What the target cannot express (a cell without a
+// [linuxcnc] table, data the runtime cannot hold, an I/O bit LinuxCNC does
+// not have, a pallet number known only at run time) is reported to `diags`
+// and gives nullopt. `program_path` names the source in the output's
+// comments (its file name only).
+std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const CompileState& state,
+                                           const std::string& program_path, Diagnostics& diags);
+
+// The name of the main program file for a source path: "layers.place" ->
+// "layers.ngc" ("-" -> "program.ngc").
+std::string LinuxCncMainName(const std::string& program_path);
+
+// Every generated file for review on one stream: the main program, then
+// smtcal_data.ngc, each after a "(smtcal file: PATH)" line. The runtime's
+// own files are not repeated (they are runtime/linuxcnc/*.ngc verbatim).
+std::string LinuxCncReviewText(const LinuxCncOutput& output);
+
+// Writes the output directory: OUTDIR/<main_name> and OUTDIR/subroutines/*.
+// Everything is written into a temporary sibling directory first and then
+// swapped in by a rename, so OUTDIR is never half-written. An existing OUTDIR
+// is replaced only when it is an earlier smtcal output (its .ngc files open
+// with smtcal's header line, subroutines/ holds only smtcal_*.ngc);
+// anything else is refused with an Error naming what is in the way.
+Status WriteLinuxCncDirectory(const std::filesystem::path& outdir, const LinuxCncOutput& output);
+
+}  // namespace smtcal

@@ -1,0 +1,157 @@
+// Reports of a compiled program (backend/reports/compile_report.h).
+#include "backend/reports/compile_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "calibration/error_table.h"
+
+namespace smtcal {
+
+namespace {
+
+using nlohmann::json;
+
+json PoseJson(const Pose4& pose) {
+  return json{{"x_mm", pose[0]}, {"y_mm", pose[1]}, {"z_mm", pose[2]}, {"u_deg", pose[3]}};
+}
+
+json FixJson(const Eigen::Affine3d& fix) {
+  std::array<double, 4> pose = PoseValues(fix);
+  return json{{"x_mm", pose[0]}, {"y_mm", pose[1]}, {"angle_deg", pose[3]}};
+}
+
+std::string FixtureName(const CompileState& state, int fixture) {
+  return fixture < 0 ? std::string("base") : state.fixtures[fixture].name;
+}
+
+}  // namespace
+
+std::string LocationText(const SourceManager& sources, SourceLoc loc) {
+  if (!loc.known()) return "<unknown>";
+  return fmt::format("{}:{}:{}", sources.File(loc.file).name, loc.line, loc.column);
+}
+
+json CompileReportJson(const ir::Program& program, const CompileState& state, const SourceManager& sources,
+                       ReportCounts counts) {
+  json targets = json::array();
+  for (const Target& target : state.targets) {
+    json entry{{"statement", TargetKeyword(*target.stmt)},
+               {"target", target.text},
+               {"location", LocationText(sources, target.stmt->loc)},
+               {"reached_from", target.call_path},
+               {"frame", FixtureName(state, target.fixture)},
+               {"correction", CorrectionKindName(target.kind)},
+               {"known_at_compile_time", target.known}};
+    if (!target.known) {
+      entry["depends_on"] = target.unknown_because;
+      targets.push_back(std::move(entry));
+      continue;
+    }
+    if (target.fixture >= 0) entry["in_fixture"] = PoseJson(target.in_frame);
+    entry["required"] = PoseJson(target.required);
+    entry["nominal"] = PoseJson(target.nominal);
+    entry["region"] = target.region != nullptr ? json(target.region->name) : json(nullptr);
+    entry["residual_mm"] = target.residual_mm;
+    entry["iterations"] = target.iterations;
+    entry["iteration_bound"] = target.iteration_bound;
+    entry["sensor_share_mm"] = target.sensor_share_mm;
+    entry["budget_mm"] = target.budget_mm;
+    if (target.region != nullptr) entry["tolerance_mm"] = target.region->tolerance_mm;
+    targets.push_back(std::move(entry));
+  }
+  json fixtures = json::array();
+  for (const FixtureBinding& binding : state.fixtures) {
+    json entry{{"name", binding.name}, {"nominal", FixJson(binding.nominal)}};
+    if (binding.fix0) entry["fix0"] = FixJson(*binding.fix0);
+    fixtures.push_back(std::move(entry));
+  }
+  json taught = json::array();
+  for (const TaughtPoint& point : state.taught) {
+    const auto& decl = std::get<ir::PointDecl>(point.decl->node);
+    taught.push_back(json{{"name", decl.name},
+                          {"location", LocationText(sources, point.decl->loc)},
+                          {"taught", PoseJson(point.taught)},
+                          {"reached", PoseJson(point.reached)},
+                          {"fixpos0", PoseJson(point.fixpos0)},
+                          {"region", point.region != nullptr ? json(point.region->name) : json(nullptr)}});
+  }
+  json cycles = json::array();
+  for (const CycleEstimate& cycle : state.cycles) {
+    double total = cycle.total_s();
+    cycles.push_back(json{{"fixture", cycle.fixture},
+                          {"location", LocationText(sources, cycle.cycle->loc)},
+                          {"placements", cycle.placements},
+                          {"motion_s", cycle.motion_s},
+                          {"scan_s", cycle.scan_s},
+                          {"total_s", total},
+                          {"scan_share", total > 0 ? cycle.scan_s / total : 0.0}});
+  }
+  return json{{"program", sources.File(program.file).name},
+              {"cell", state.cell->path},
+              {"errors", counts.errors},
+              {"warnings", counts.warnings},
+              {"complete", state.trace_complete},
+              {"fixtures", fixtures},
+              {"taught_points", taught},
+              {"targets", targets},
+              {"cycles", cycles}};
+}
+
+std::string VerifySummaryText(const ir::Program& program, const CompileState& state, const SourceManager& sources,
+                              ReportCounts counts) {
+  std::map<CorrectionKind, int> by_kind;
+  int placements = 0, unknown = 0;
+  const Target* worst_residual = nullptr;
+  const Target* worst_budget = nullptr;
+  for (const Target& target : state.targets) {
+    ++by_kind[target.kind];
+    if (target.is_placement()) ++placements;
+    if (!target.known) {
+      ++unknown;
+      continue;
+    }
+    if (target.kind == CorrectionKind::kUncorrected || target.region == nullptr) continue;
+    if (worst_residual == nullptr || target.residual_mm > worst_residual->residual_mm) worst_residual = &target;
+    bool pick_place = std::holds_alternative<ir::PickPlace>(target.stmt->node);
+    if (pick_place && (worst_budget == nullptr ||
+                       target.budget_mm / target.region->tolerance_mm >
+                           worst_budget->budget_mm / worst_budget->region->tolerance_mm)) {
+      worst_budget = &target;
+    }
+  }
+  auto describe = [&](const Target& target) {
+    return fmt::format("{} {} at {}", TargetKeyword(*target.stmt), target.text, LocationText(sources, target.stmt->loc));
+  };
+  std::string text = fmt::format("{}: compiled for cell '{}' ({})\n", sources.File(program.file).name,
+                                 state.cell->name, state.cell->path);
+  text += fmt::format("  targets: {} ({} static, {} fixture, {} run-time, {} uncorrected), {} placement targets\n",
+                      state.targets.size(), by_kind[CorrectionKind::kStatic], by_kind[CorrectionKind::kFixture],
+                      by_kind[CorrectionKind::kRunTimeBase], by_kind[CorrectionKind::kUncorrected], placements);
+  if (unknown > 0) text += fmt::format("  {} target(s) known only at run time: not verified\n", unknown);
+  if (worst_residual != nullptr) {
+    text += fmt::format("  worst residual: {:.1e} mm, {}\n", worst_residual->residual_mm, describe(*worst_residual));
+  }
+  if (worst_budget != nullptr) {
+    text += fmt::format("  worst budget: {:.4f} mm of ±{} mm (residual {:.1e} + repeatability {} + sensor {:.4f}), {}\n",
+                        worst_budget->budget_mm, FormatMm(worst_budget->region->tolerance_mm),
+                        worst_budget->residual_mm, FormatMm(state.cell->robot.repeatability_mm),
+                        worst_budget->sensor_share_mm, describe(*worst_budget));
+  }
+  for (const CycleEstimate& cycle : state.cycles) {
+    double total = cycle.total_s();
+    text += fmt::format("  cycle {} at {}: {} placements, about {:.1f} s, of which the scan {:.1f} s ({:.1f} %)\n",
+                        cycle.fixture, LocationText(sources, cycle.cycle->loc), cycle.placements, total, cycle.scan_s,
+                        total > 0 ? 100.0 * cycle.scan_s / total : 0.0);
+  }
+  if (!state.trace_complete) text += "  the compile-time run stopped early: later targets were not verified\n";
+  text += counts.errors == 0
+              ? fmt::format("  verdict: ok{}\n", counts.warnings > 0 ? fmt::format(" ({} warning(s) above)", counts.warnings) : "")
+              : fmt::format("  verdict: {} problem(s), listed above; do not deploy\n", counts.errors);
+  return text;
+}
+
+}  // namespace smtcal

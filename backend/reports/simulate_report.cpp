@@ -1,0 +1,334 @@
+// Reports of `smtcal simulate` (backend/reports/simulate_report.h).
+#include "backend/reports/simulate_report.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "backend/reports/svg_text.h"
+
+namespace smtcal {
+namespace {
+
+struct Summary {
+  double mean = 0, p50 = 0, p95 = 0, p99 = 0, max = 0;
+};
+
+Summary Summarize(const std::vector<double>& errors_um) {
+  Summary s;
+  if (errors_um.empty()) return s;
+  std::vector<double> sorted = errors_um;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double e : sorted) sum += e;
+  s.mean = sum / static_cast<double>(sorted.size());
+  s.p50 = Percentile(sorted, 0.50);
+  s.p95 = Percentile(sorted, 0.95);
+  s.p99 = Percentile(sorted, 0.99);
+  s.max = sorted.back();
+  return s;
+}
+
+double WithinFraction(const ModeResult& m) {
+  return m.placements > 0 ? static_cast<double>(m.within) / static_cast<double>(m.placements) : 0.0;
+}
+
+// Rounded for the JSON report: a thousandth of a micrometre, a millionth of a fraction.
+double Round(double value, double unit) { return std::round(value / unit) * unit; }
+
+std::string_view ShiftName(ShiftDistribution shift) {
+  switch (shift) {
+    case ShiftDistribution::kExponential: return "exponential";
+    case ShiftDistribution::kNormal: return "normal";
+    case ShiftDistribution::kUniform: return "uniform";
+    case ShiftDistribution::kFixed: return "fixed";
+  }
+  return "?";
+}
+
+std::string_view TablesName(TruthTables tables) {
+  switch (tables) {
+    case TruthTables::kDerived: return "derived";
+    case TruthTables::kCell: return "cell";
+    case TruthTables::kNone: return "none";
+  }
+  return "?";
+}
+
+double SensorAccuracy(const TruthSpec& truth, const cell::Cell& cell) {
+  if (!truth.noise) return 0;
+  if (truth.sensor_accuracy_mm) return *truth.sensor_accuracy_mm;
+  return cell.fixtures.empty() ? 0.0 : cell.fixtures.front().sensor_accuracy_mm;
+}
+
+double Repeatability(const TruthSpec& truth, const cell::Cell& cell) {
+  return truth.noise ? truth.repeatability_mm.value_or(cell.robot.repeatability_mm) : 0.0;
+}
+
+std::string BoardText(const BoardPoseModel& board) {
+  if (board.shift == ShiftDistribution::kFixed) {
+    return fmt::format("board fixed: shift ({}, {}) mm, rotation {}°", board.fixed_shift_mm.x(),
+                       board.fixed_shift_mm.y(), board.fixed_rotation_deg);
+  }
+  std::string_view scale = board.shift == ShiftDistribution::kExponential ? "mean"
+                           : board.shift == ShiftDistribution::kNormal    ? "sd per axis"
+                                                                          : "radius";
+  return fmt::format("board shift {} ({} {} mm, max {} mm), rotation normal (sd {}°, max {}°)", ShiftName(board.shift),
+                     scale, board.shift_scale_mm, board.shift_max_mm, board.rotation_sd_deg, board.rotation_max_deg);
+}
+
+constexpr std::array<const char*, 6> kModeColours = {"#7f7f7f", "#bcbd22", "#1f77b4",
+                                                     "#9467bd", "#ff7f0e", "#2ca02c"};
+
+}  // namespace
+
+std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
+  std::string field = fmt::format("tables {}", TablesName(truth.tables));
+  if (truth.tables == TruthTables::kDerived) {
+    field += truth.noise ? fmt::format(" (nodes moved by {} x their standard error)", truth.perturbation_scale)
+                         : " (noise off: the tables as they are)";
+  }
+  if (!truth.region_tables.empty()) field += fmt::format(", {} true table(s) given", truth.region_tables.size());
+  field += truth.outside == TruthOutside::kFade ? fmt::format(", outside fading to 0 over {} mm", truth.fade_mm)
+                                                : std::string(", outside clamped to the edge values");
+  if (truth.offset_mm != Eigen::Vector2d::Zero()) {
+    field += fmt::format(", offset ({}, {}) mm", truth.offset_mm.x(), truth.offset_mm.y());
+  }
+  if (truth.rotation_deg != 0 || truth.scale_ppm != 0) {
+    field += fmt::format(", rotation {}° and scale {} ppm about ({}, {})", truth.rotation_deg, truth.scale_ppm,
+                         truth.about_mm.x(), truth.about_mm.y());
+  }
+  return fmt::format("{}; {}; sensor ±{} mm, repeatability ±{} mm (uniform){}", field, BoardText(truth.board),
+                     SensorAccuracy(truth, cell), Repeatability(truth, cell), truth.noise ? "" : ", noise off");
+}
+
+std::string SimulateReportText(const SimResult& result, const SimulateContext& context) {
+  std::string out;
+  const SimOptions& o = result.options;
+  out += fmt::format("smtcal simulate: {} on cell '{}', {} cycles (seed {}), {} placements planned\n",
+                     context.program, context.cell->name, result.cycles, o.seed, result.placements_planned);
+  out += fmt::format("truth: {}{}\n", context.truth->path.empty() ? "" : context.truth->path + ": ",
+                     DescribeTruth(*context.truth, *context.cell));
+  if (o.missed_trip_rate > 0 || o.dirty_marker_rate > 0 || o.board_beyond_rate > 0) {
+    out += fmt::format("faults injected: missed trip {} cycles, dirty marker {} (±{} mm), board beyond limits {}\n",
+                       result.injected_missed, result.injected_dirty, o.dirty_marker_mm, result.injected_beyond);
+  }
+  if (result.unknown_targets > 0) {
+    out += fmt::format("not simulated: {} placement(s) known only at run time\n", result.unknown_targets);
+  }
+  out += fmt::format("\n{:<12} {:>9} {:>10} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>6}\n", "mode", "placed",
+                     "within", "out", "faults", "mean", "p50", "p95", "p99", "max", "scan");
+  out += fmt::format("{:<12} {:>9} {:>10} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>6}\n", "", "", "tolerance",
+                     "", "cycles", "µm", "µm", "µm", "µm", "µm", "share");
+  for (const ModeResult& m : result.modes) {
+    const Summary s = Summarize(m.errors_um);
+    if (m.placements == 0) {  // every cycle stopped: no distribution to show
+      out += fmt::format("{:<12} {:>9} {:>10} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>5.1f}%\n",
+                         SimModeName(m.mode), 0, "-", 0, m.faults, "-", "-", "-", "-", "-", 100 * m.scan_share);
+      continue;
+    }
+    out += fmt::format("{:<12} {:>9} {:>9.3f}% {:>7} {:>7} {:>7.1f} {:>7.1f} {:>7.1f} {:>7.1f} {:>7.1f} {:>5.1f}%\n",
+                       SimModeName(m.mode), m.placements, 100 * WithinFraction(m), m.placements - m.within, m.faults,
+                       s.mean, s.p50, s.p95, s.p99, s.max, 100 * m.scan_share);
+  }
+  bool any_faults = false;
+  for (const ModeResult& m : result.modes) any_faults = any_faults || m.faults > 0;
+  if (any_faults) {
+    out += "\nfaults (the first failed check of each stopped cycle):\n";
+    for (const ModeResult& m : result.modes) {
+      if (m.faults == 0) continue;
+      std::string list;
+      for (const auto& [check, count] : m.fault_checks) list += fmt::format("{}{} {}", list.empty() ? "" : ", ", check, count);
+      out += fmt::format("  {:<12} {}\n", SimModeName(m.mode), list);
+    }
+  }
+  if (o.missed_trip_rate > 0 || o.dirty_marker_rate > 0 || o.board_beyond_rate > 0) {
+    out += fmt::format("\ncycles with an injected fault: {}; per mode, how many of them stopped and how many parts "
+                       "they placed out of tolerance:\n", result.injected_cycles);
+    for (const ModeResult& m : result.modes) {
+      out += fmt::format("  {:<12} stopped {:>6}   misplaced {:>6}\n", SimModeName(m.mode), m.faults_injected,
+                         m.misplaced_injected);
+    }
+  }
+  out += "\nmodes:\n";
+  for (const ModeResult& m : result.modes) {
+    std::string description(SimModeDescription(m.mode));
+    if (m.mode == SimMode::kImproved) description += fmt::format(" (estimator {})", result.fixture_estimator);
+    out += fmt::format("  {:<12} {}\n", SimModeName(m.mode), description);
+  }
+  return out;
+}
+
+nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext& context) {
+  const SimOptions& o = result.options;
+  nlohmann::json modes = nlohmann::json::array();
+  for (const ModeResult& m : result.modes) {
+    const Summary s = Summarize(m.errors_um);
+    nlohmann::json checks = nlohmann::json::object();
+    for (const auto& [check, count] : m.fault_checks) checks[check] = count;
+    modes.push_back({{"mode", SimModeName(m.mode)},
+                     {"description", SimModeDescription(m.mode)},
+                     {"cycles", m.cycles},
+                     {"faults", m.faults},
+                     {"fault_checks", checks},
+                     {"placed", m.placements},
+                     {"within_tolerance", m.within},
+                     {"within_fraction", m.placements == 0 ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(Round(WithinFraction(m), 1e-6))},
+                     {"out_of_tolerance", m.placements - m.within},
+                     {"injected_cycles_stopped", m.faults_injected},
+                     {"misplaced_in_injected_cycles", m.misplaced_injected},
+                     {"error_um", m.placements == 0 ? nlohmann::json(nullptr)
+                                                    : nlohmann::json{{"mean", Round(s.mean, 1e-3)},
+                                                                     {"p50", Round(s.p50, 1e-3)},
+                                                                     {"p95", Round(s.p95, 1e-3)},
+                                                                     {"p99", Round(s.p99, 1e-3)},
+                                                                     {"max", Round(s.max, 1e-3)}}},
+                     {"scan_share", Round(m.scan_share, 1e-6)}});
+  }
+  return {{"program", context.program},
+          {"cell", context.cell->name},
+          {"truth_file", context.truth->path},
+          {"truth", DescribeTruth(*context.truth, *context.cell)},
+          {"seed", o.seed},
+          {"cycles", result.cycles},
+          {"cycles_per_statement", o.cycles},
+          {"placements_planned", result.placements_planned},
+          {"placements_not_simulated", result.unknown_targets},
+          {"improved_estimator", result.fixture_estimator},
+          {"injected",
+           {{"missed_trip", {{"rate", o.missed_trip_rate}, {"cycles", result.injected_missed}}},
+            {"dirty_marker",
+             {{"rate", o.dirty_marker_rate}, {"cycles", result.injected_dirty}, {"displacement_mm", o.dirty_marker_mm}}},
+            {"board_beyond_limits", {{"rate", o.board_beyond_rate}, {"cycles", result.injected_beyond}}},
+            {"cycles_with_any", result.injected_cycles}}},
+          {"modes", modes}};
+}
+
+std::string SimulateReportSvg(const SimResult& result, const SimulateContext& context) {
+  constexpr double kPanel = 280, kGap = 50, kLeft = 50, kTop = 115;
+  constexpr int kColumns = 3;
+  const double tolerance_um = 1000 * (result.tolerance_mm > 0 ? result.tolerance_mm : 0.1);
+  const double range_um = 2.5 * tolerance_um;  // scatter: +-range around the required position
+  const int rows = static_cast<int>((result.modes.size() + kColumns - 1) / kColumns);
+  const double width = kLeft + kColumns * (kPanel + kGap);
+  const double hist_top = kTop + rows * (kPanel + kGap) + 30, hist_height = 260;
+  const std::vector<std::string> truth_lines = [&] {
+    std::vector<std::string> lines;
+    std::string text = "true world: " + DescribeTruth(*context.truth, *context.cell);
+    for (std::size_t at = 0; at != std::string::npos;) {
+      const std::size_t next = text.find("; ", at);
+      lines.push_back(text.substr(at, next == std::string::npos ? next : next - at));
+      at = next == std::string::npos ? next : next + 2;
+    }
+    return lines;
+  }();
+  const double height = hist_top + hist_height + 50 + 16 * static_cast<double>(truth_lines.size());
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" viewBox=\"0 0 {:.0f} {:.0f}\" "
+      "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      width, height, width, height);
+  svg += fmt::format("<text x=\"{}\" y=\"24\" font-size=\"16\" font-weight=\"bold\">Placement error per correction "
+                     "mode: {} on cell {} ({} cycles, seed {})</text>\n",
+                     kLeft, SvgEscape(std::filesystem::path(context.program).filename().string()),
+                     SvgEscape(context.cell->name), result.cycles, result.options.seed);
+  svg += fmt::format("<text x=\"{}\" y=\"46\">Each dot: one placed part, where it landed relative to where it "
+                     "belongs, in µm (up to {} per mode, the same parts in every mode).</text>\n",
+                     kLeft, result.options.scatter_points);
+  svg += fmt::format("<text x=\"{}\" y=\"64\">Dashed circle: the tolerance ±{:.0f} µm. Red: beyond ±{:.0f} µm, "
+                     "drawn at the border.</text>\n",
+                     kLeft, tolerance_um, range_um);
+  for (std::size_t i = 0; i < result.modes.size(); ++i) {
+    const ModeResult& m = result.modes[i];
+    const double x0 = kLeft + static_cast<double>(i % kColumns) * (kPanel + kGap);
+    const double y0 = kTop + static_cast<double>(i / kColumns) * (kPanel + kGap);
+    const double cx = x0 + kPanel / 2, cy = y0 + kPanel / 2, per_um = kPanel / (2 * range_um);
+    const Summary s = Summarize(m.errors_um);
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", x0, y0 - 24,
+                       kModeColours[i], SimModeName(m.mode));
+    svg += m.placements == 0
+               ? fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">no part placed, {} cycles stopped</text>\n", x0, y0 - 8,
+                             m.faults)
+               : fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{:.2f}% within, p99 {:.0f} µm, {} cycles stopped</text>\n",
+                             x0, y0 - 8, 100 * WithinFraction(m), s.p99, m.faults);
+    svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.0f}\" height=\"{:.0f}\" fill=\"#fafafa\" "
+                       "stroke=\"#999\"/>\n", x0, y0, kPanel, kPanel);
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n", x0, cy,
+                       x0 + kPanel, cy);
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n", cx, y0, cx,
+                       y0 + kPanel);
+    svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.35\">\n", kModeColours[i]);
+    std::string outside;
+    for (const Eigen::Vector2d& e : m.scatter_um) {
+      const double scale = std::max({std::abs(e.x()), std::abs(e.y()), range_um}) / range_um;
+      const Eigen::Vector2d p = e / scale;
+      std::string dot = fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\"/>\n", cx + p.x() * per_um,
+                                    cy - p.y() * per_um);
+      (scale > 1 ? outside : svg) += dot;
+    }
+    svg += "</g>\n";
+    if (m.placements == 0) {
+      svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">no part placed: every cycle "
+                         "stopped</text>\n<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">by a failed scan "
+                         "check</text>\n", cx, cy + 80, cx, cy + 96);
+    }
+    if (!outside.empty()) svg += "<g fill=\"#d62728\">\n" + outside + "</g>\n";
+    svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{:.1f}\" fill=\"none\" stroke=\"black\" "
+                       "stroke-dasharray=\"5,4\"/>\n", cx, cy, tolerance_um * per_um);
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#666\">x error (µm), "
+                       "±{:.0f}</text>\n", cx, y0 + kPanel + 16, range_um);
+  }
+  // Histograms of the error lengths: the fraction of each mode's parts per bin.
+  constexpr int kBins = 60;
+  const double hist_max_um = 3 * tolerance_um, bin_um = hist_max_um / kBins;
+  const double hx0 = kLeft, hw = width - kLeft - kGap - 150;
+  std::vector<std::vector<double>> fractions;
+  double top_fraction = 0;
+  for (const ModeResult& m : result.modes) {
+    std::vector<double> bins(kBins, 0.0);
+    for (double e : m.errors_um) bins[std::min(kBins - 1, static_cast<int>(e / bin_um))] += 1;
+    for (double& b : bins) b = m.errors_um.empty() ? 0 : b / static_cast<double>(m.errors_um.size());
+    top_fraction = std::max(top_fraction, *std::max_element(bins.begin(), bins.end()));
+    fractions.push_back(bins);
+  }
+  if (top_fraction <= 0) top_fraction = 1;
+  svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" font-weight=\"bold\">Error length histogram (fraction of placed "
+                     "parts per {:.0f} µm bin; the last bin holds everything beyond)</text>\n",
+                     hx0, hist_top - 10, bin_um);
+  svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"#fafafa\" "
+                     "stroke=\"#999\"/>\n", hx0, hist_top, hw, hist_height);
+  const double tol_x = hx0 + hw * tolerance_um / hist_max_um;
+  svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"black\" "
+                     "stroke-dasharray=\"5,4\"/>\n<text x=\"{:.1f}\" y=\"{:.1f}\">tolerance</text>\n",
+                     tol_x, hist_top, tol_x, hist_top + hist_height, tol_x + 4, hist_top + 14);
+  for (int tick = 0; tick <= 6; ++tick) {
+    const double um = hist_max_um * tick / 6;
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#666\">{:.0f} µm</text>\n",
+                       hx0 + hw * tick / 6, hist_top + hist_height + 16, um);
+  }
+  for (std::size_t i = 0; i < fractions.size(); ++i) {
+    std::string points;
+    for (int b = 0; b < kBins; ++b) {
+      const double y = hist_top + hist_height * (1 - fractions[i][b] / top_fraction);
+      points += fmt::format("{:.1f},{:.1f} {:.1f},{:.1f} ", hx0 + hw * b / kBins, y, hx0 + hw * (b + 1) / kBins, y);
+    }
+    svg += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n", points,
+                       kModeColours[i]);
+    const double ly = hist_top + 14 + 20 * static_cast<double>(i);
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" "
+                       "stroke-width=\"3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
+                       hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, kModeColours[i], hx0 + hw + 42, ly,
+                       SimModeName(result.modes[i].mode));
+  }
+  for (std::size_t i = 0; i < truth_lines.size(); ++i) {
+    svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" fill=\"#666\">{}</text>\n", kLeft,
+                       hist_top + hist_height + 50 + 16 * static_cast<double>(i), truth_lines[i]);
+  }
+  svg += "</svg>\n";
+  return svg;
+}
+
+}  // namespace smtcal

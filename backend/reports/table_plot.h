@@ -1,0 +1,21 @@
+// `smtcal table plot`: the error field as a standalone SVG, like the paper's
+// Figure 5 but read at a glance. Two panels, Delta-x and Delta-y, each over
+// its own grid: a diverging colour map centred on 0 (blue negative, red
+// positive) with a legend bar in µm, the grid nodes as dots, and the error
+// vectors (Delta-x, Delta-y) at the nodes as arrows, exaggerated by a stated
+// factor with a scale bar. Axes in mm. Deterministic: the same table gives the
+// same bytes.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "calibration/error_table.h"
+
+namespace smtcal {
+
+// `title` is printed at the top (usually the table's file name). Requires
+// HasUsableShape.
+std::string PlotTableSvg(const ErrorTable& table, std::string_view title);
+
+}  // namespace smtcal

@@ -1,0 +1,201 @@
+#include "base/diagnostics.h"
+
+#include <algorithm>
+#include <cctype>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
+
+namespace smtcal {
+namespace {
+
+struct KindInfo {
+  std::string_view name;
+  Severity severity;
+  std::string_view format;
+};
+
+constexpr KindInfo kKinds[] = {
+#define DIAG(name, severity, format) {#name, Severity::severity, format},
+#include "base/diagnostic_kinds.def"
+#undef DIAG
+};
+
+const KindInfo& Info(DiagKind kind) { return kKinds[static_cast<std::size_t>(kind)]; }
+
+std::string Location(const SourceManager& sources, const SourceRange& range) {
+  if (range.begin.file == 0) return "smtcal";
+  const SourceFile& file = sources.File(range.begin.file);
+  if (range.begin.line == 0) return file.name;
+  return fmt::format("{}:{}:{}", file.name, range.begin.line, range.begin.column);
+}
+
+// Length of the valid UTF-8 sequence starting at text[i], or 0 if invalid.
+std::size_t Utf8SequenceLength(std::string_view text, std::size_t i) {
+  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  unsigned char lead = byte(i);
+  std::size_t length = lead < 0x80 ? 1 : (lead >> 5) == 0x6 ? 2 : (lead >> 4) == 0xE ? 3
+                                   : (lead >> 3) == 0x1E ? 4 : 0;
+  if (length == 0 || i + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(i + k) & 0xC0) != 0x80) return 0;
+  }
+  return length;
+}
+
+// The quoted source line and a caret line under the range. The line is made
+// safe for a terminal (control characters and invalid UTF-8 bytes become
+// '?'), and the caret line advances one column per character, not per byte,
+// so the caret sits under the right character in UTF-8 text. Tabs are kept.
+void AppendSnippet(std::string& out, const SourceManager& sources, const SourceRange& range) {
+  if (!range.begin.known()) return;
+  std::string_view line = sources.File(range.begin.file).Line(range.begin.line);
+  std::size_t begin = range.begin.column == 0 ? 0 : range.begin.column - 1;
+  std::size_t end = begin + std::max<std::uint32_t>(range.length, 1);
+  std::string shown;
+  std::string marks;
+  bool caret_placed = false;
+  for (std::size_t i = 0; i < line.size();) {
+    std::size_t length = Utf8SequenceLength(line, i);
+    unsigned char c = static_cast<unsigned char>(line[i]);
+    bool printable = length > 1 || (length == 1 && (c >= 0x20 || c == '\t') && c != 0x7F);
+    std::size_t step = length == 0 ? 1 : length;
+    shown += printable ? std::string(line.substr(i, step)) : std::string("?");
+    char mark = c == '\t' ? '\t' : ' ';
+    if (i >= begin && i < end) mark = caret_placed ? '~' : '^';
+    if (mark == '^') caret_placed = true;
+    marks += mark;
+    i += step;
+  }
+  if (!caret_placed) marks += '^';  // the range starts at the end of the line
+  while (!marks.empty() && (marks.back() == ' ' || marks.back() == '\t')) marks.pop_back();
+  out += fmt::format("  {}\n  {}\n", shown, marks);
+}
+
+// Diagnostics in source order (file, line, column), whatever pass found them;
+// equal locations keep the order they were reported in. Diagnostics about a
+// whole file (no line) follow that file's located ones, and the
+// too-many-errors marker stays last: both are summaries.
+std::vector<const Diagnostic*> InSourceOrder(const std::vector<Diagnostic>& diagnostics) {
+  std::vector<const Diagnostic*> sorted;
+  for (const Diagnostic& diag : diagnostics) sorted.push_back(&diag);
+  std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic* a, const Diagnostic* b) {
+    bool a_last = a->kind == DiagKind::TooManyErrors;
+    bool b_last = b->kind == DiagKind::TooManyErrors;
+    if (a_last != b_last) return b_last;
+    const SourceLoc& x = a->range.begin;
+    const SourceLoc& y = b->range.begin;
+    bool x_whole_file = x.line == 0;
+    bool y_whole_file = y.line == 0;
+    return std::tie(x.file, x_whole_file, x.line, x.column) <
+           std::tie(y.file, y_whole_file, y.line, y.column);
+  });
+  return sorted;
+}
+
+}  // namespace
+
+std::string_view DiagKindName(DiagKind kind) { return Info(kind).name; }
+Severity DiagKindSeverity(DiagKind kind) { return Info(kind).severity; }
+std::string_view DiagKindFormat(DiagKind kind) { return Info(kind).format; }
+
+std::string_view SeverityName(Severity severity) {
+  switch (severity) {
+    case Severity::Note: return "note";
+    case Severity::Warning: return "warning";
+    case Severity::Error: return "error";
+  }
+  return "error";
+}
+
+Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
+  if (limit_reached_) return nullptr;
+  Severity severity = DiagKindSeverity(kind);
+  if (severity == Severity::Error && error_count_ >= error_limit_) {
+    limit_reached_ = true;
+    diagnostics_.push_back({DiagKind::TooManyErrors, Severity::Error, range,
+                            fmt::format("too many errors ({}); stopping here", error_count_), {}});
+    ++error_count_;
+    return nullptr;
+  }
+  if (severity == Severity::Error) ++error_count_;
+  if (severity == Severity::Warning) ++warning_count_;
+  diagnostics_.push_back({kind, severity, range, std::move(message), {}});
+  return &diagnostics_.back();
+}
+
+std::string Diagnostics::RenderText() const {
+  std::string out;
+  for (const Diagnostic* sorted : InSourceOrder(diagnostics_)) {
+    const Diagnostic& diag = *sorted;
+    out += fmt::format("{}: {}: {}\n", Location(sources_, diag.range), SeverityName(diag.severity),
+                       diag.message);
+    AppendSnippet(out, sources_, diag.range);
+    for (const auto& [range, text] : diag.notes) {
+      out += fmt::format("{}: note: {}\n", Location(sources_, range), text);
+      AppendSnippet(out, sources_, range);
+    }
+  }
+  return out;
+}
+
+std::string Diagnostics::RenderJson() const {
+  auto located = [&](const SourceRange& range) {
+    nlohmann::ordered_json j;
+    j["file"] = range.begin.file == 0 ? "" : sources_.File(range.begin.file).name;
+    j["line"] = range.begin.line;
+    j["column"] = range.begin.column;
+    j["length"] = range.length;
+    return j;
+  };
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const Diagnostic* sorted : InSourceOrder(diagnostics_)) {
+    const Diagnostic& diag = *sorted;
+    nlohmann::ordered_json j;
+    j["kind"] = DiagKindName(diag.kind);
+    j["severity"] = SeverityName(diag.severity);
+    j.update(located(diag.range));
+    j["message"] = diag.message;
+    nlohmann::ordered_json notes = nlohmann::ordered_json::array();
+    for (const auto& [range, text] : diag.notes) {
+      nlohmann::ordered_json note = located(range);
+      note["message"] = text;
+      notes.push_back(std::move(note));
+    }
+    j["notes"] = std::move(notes);
+    list.push_back(std::move(j));
+  }
+  // replace: a message quoting invalid UTF-8 from the input must not throw.
+  return list.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+}
+
+std::string ClosestName(std::string_view name, const std::vector<std::string>& candidates) {
+  auto lower = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
+  auto distance = [&](std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        std::size_t above = row[j];
+        std::size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + cost});
+        diagonal = above;
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  std::size_t best_distance = std::max<std::size_t>(1, name.size() / 3) + 1;
+  for (const std::string& candidate : candidates) {
+    std::size_t d = distance(name, candidate);
+    if (d < best_distance) {
+      best_distance = d;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+}  // namespace smtcal

@@ -1,0 +1,92 @@
+// Mistakes in the user's input. Each kind is declared once in
+// diagnostic_kinds.def with its severity and message format; the code that
+// finds the mistake reports it with typed arguments. Rendering (GCC/Clang text
+// with the source line and a caret, or JSON) is separate from collecting.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "base/source.h"
+
+namespace smtcal {
+
+enum class DiagKind : std::uint16_t {
+#define DIAG(name, severity, format) name,
+#include "base/diagnostic_kinds.def"
+#undef DIAG
+};
+
+enum class Severity { Note, Warning, Error };
+
+std::string_view DiagKindName(DiagKind kind);
+Severity DiagKindSeverity(DiagKind kind);
+std::string_view DiagKindFormat(DiagKind kind);
+std::string_view SeverityName(Severity severity);
+
+// A location plus how many bytes the caret underline covers.
+struct SourceRange {
+  SourceLoc begin;
+  std::uint32_t length = 1;
+  SourceRange() = default;
+  SourceRange(SourceLoc loc, std::uint32_t len = 1) : begin(loc), length(len == 0 ? 1 : len) {}
+};
+
+struct Diagnostic {
+  DiagKind kind;
+  Severity severity;
+  SourceRange range;
+  std::string message;
+  std::vector<std::pair<SourceRange, std::string>> notes;  // "note:" lines after it
+};
+
+class Diagnostics {
+ public:
+  explicit Diagnostics(const SourceManager& sources, std::size_t error_limit = 50)
+      : sources_(sources), error_limit_(error_limit) {}
+
+  template <typename... Args>
+  Diagnostic* Report(DiagKind kind, SourceRange range, const Args&... args) {
+    return Add(kind, range, fmt::vformat(DiagKindFormat(kind), fmt::make_format_args(args...)));
+  }
+  // Attaches a note to the diagnostic returned by Report (ignored if null:
+  // Report returns null once the error limit is reached).
+  static void AddNote(Diagnostic* diag, SourceRange range, std::string text) {
+    if (diag != nullptr) diag->notes.emplace_back(range, std::move(text));
+  }
+
+  std::size_t error_count() const { return error_count_; }
+  std::size_t warning_count() const { return warning_count_; }
+  bool has_errors() const { return error_count_ > 0; }
+  bool limit_reached() const { return limit_reached_; }
+  const std::vector<Diagnostic>& all() const { return diagnostics_; }
+  const SourceManager& sources() const { return sources_; }
+
+  // Both renderings list the diagnostics in source order (file, line,
+  // column), not in the order the passes found them.
+  // GCC/Clang style: "file:line:col: error: message", the source line, a caret.
+  std::string RenderText() const;
+  // The same as a JSON array of objects (kind, severity, file, line, column,
+  // length, message, notes).
+  std::string RenderJson() const;
+
+ private:
+  Diagnostic* Add(DiagKind kind, SourceRange range, std::string message);
+
+  const SourceManager& sources_;
+  std::size_t error_limit_;
+  std::size_t error_count_ = 0;
+  std::size_t warning_count_ = 0;
+  bool limit_reached_ = false;
+  std::vector<Diagnostic> diagnostics_;
+};
+
+// "did you mean 'X'?" helper: the closest candidate by edit distance
+// (case-insensitive), or empty when nothing is close enough.
+std::string ClosestName(std::string_view name, const std::vector<std::string>& candidates);
+
+}  // namespace smtcal

@@ -1,0 +1,84 @@
+#include "base/source.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+
+#include <fmt/core.h>
+#include <unistd.h>
+
+namespace smtcal {
+
+std::string_view SourceFile::Line(std::uint32_t line) const {
+  if (line == 0 || line > line_starts.size()) return {};
+  std::size_t begin = line_starts[line - 1];
+  std::size_t end = line < line_starts.size() ? line_starts[line] : text.size();
+  std::string_view view(text.data() + begin, end - begin);
+  while (!view.empty() && (view.back() == '\n' || view.back() == '\r')) view.remove_suffix(1);
+  return view;
+}
+
+std::uint32_t SourceManager::Add(std::string name, std::string text) {
+  auto file = std::make_unique<SourceFile>();
+  file->name = std::move(name);
+  file->text = std::move(text);
+  file->line_starts.push_back(0);
+  for (std::size_t i = 0; i < file->text.size(); ++i) {
+    if (file->text[i] == '\n' && i + 1 < file->text.size()) file->line_starts.push_back(i + 1);
+  }
+  files_.push_back(std::move(file));
+  return static_cast<std::uint32_t>(files_.size());
+}
+
+Result<std::uint32_t> SourceManager::Load(const std::string& path) {
+  std::string text;
+  if (path == "-") {
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    return Add("<stdin>", std::move(text));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{fmt::format("cannot open '{}': {}", path, std::strerror(errno))};
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) return Error{fmt::format("cannot read '{}': {}", path, std::strerror(errno))};
+  return Add(path, std::move(buffer).str());
+}
+
+const SourceFile& SourceManager::File(std::uint32_t id) const {
+  SMTCAL_CHECK(id >= 1 && id <= files_.size(), "unknown source file id");
+  return *files_[id - 1];
+}
+
+Status WriteFileAtomically(const std::string& path, std::string_view contents) {
+  if (path == "-") {
+    std::cout.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    std::cout.flush();
+    if (!std::cout) return Error{"cannot write to standard output"};
+    return Ok{};
+  }
+  std::string temp = fmt::format("{}.tmp.{}", path, ::getpid());
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    // Name the file the user asked for; the temporary is our business.
+    if (!out) return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
+    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    out.flush();
+    if (!out) {
+      std::remove(temp.c_str());
+      return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
+    }
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    int saved = errno;
+    std::remove(temp.c_str());
+    return Error{fmt::format("cannot write '{}' (renaming the finished temporary '{}' failed): {}",
+                             path, temp, std::strerror(saved))};
+  }
+  return Ok{};
+}
+
+}  // namespace smtcal

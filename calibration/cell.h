@@ -1,0 +1,224 @@
+// The cell: what smtcal knows about the robot cell a program runs in, as
+// loaded from a `*.cell.toml` file by frontend/cell_toml.h (docs/cell.md documents every key with the paper
+// cell's example). Units as in the file: mm, degrees, seconds; the loader
+// converts nothing except that every `*_deg` value is kept in degrees here
+// too (the math converts where it uses them).
+//
+// Every part keeps the SourceRange of the TOML key or table it came from, so
+// a pass that finds something wrong with the cell points into the cell file.
+//
+// Loading (frontend/cell_toml.cpp) reports every mistake it finds (unknown
+// key, wrong type, missing key, value out of range, a table file that is
+// missing or invalid, marker geometry that contradicts L1/L2, overlapping
+// regions ...) as a diagnostic located in the TOML file, and returns nullopt
+// when any was an error. A loaded Cell therefore satisfies every check listed
+// in docs/cell.md ("What the loader checks").
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "base/source.h"
+#include "calibration/error_table.h"
+#include "calibration/inverse_calibration.h"
+
+namespace smtcal::cell {
+
+// [lo, hi] with lo < hi, in the key's unit.
+struct Interval {
+  double lo = 0;
+  double hi = 0;
+  bool Contains(double v) const { return v >= lo && v <= hi; }
+};
+
+// A 2-D point given as [x, y] in the file (mm).
+using Point2 = Eigen::Vector2d;
+
+// [robot]
+struct Robot {
+  std::string model;                      // free text, for reports
+  std::array<Interval, 4> limits;         // x_mm, y_mm, z_mm, u_deg: reachable commanded positions
+  std::array<SourceRange, 4> limit_keys;  // where each limit is written (its key)
+  double repeatability_mm = 0;            // +- band of repeated moves to one point
+  double safe_limz_mm = 0;                // z a Jump rises to when it has no LimZ
+  // Motion model for cycle-time estimates: each axis moves with a trapezoidal
+  // profile (accelerate, cruise, decelerate); x and y move together, the
+  // slower of the two decides.
+  double xy_speed_mm_s = 0;
+  double xy_accel_mm_s2 = 0;
+  double z_speed_mm_s = 0;
+  double z_accel_mm_s2 = 0;
+  double u_speed_deg_s = 0;
+  double u_accel_deg_s2 = 0;
+  double pick_time_s = 0;   // vacuum on and settle at a pick
+  double place_time_s = 0;  // vacuum off and release at a place
+  SourceRange range;        // the [robot] table
+};
+
+// The axes a region's difficulty measure names.
+enum class TaskAxis { X, Y, Z, U };
+
+// [[region]]: a calibrated region of the work space.
+struct Region {
+  std::string name;
+  SourceRange name_range;
+  // Bounds in the robot base frame, on required (actual) positions: a target
+  // belongs to the region when its required x, y lie within them. Default:
+  // the table's domain. Always inside the domain.
+  Interval x_mm, y_mm;
+  // The x_mm key (else the y_mm key, else the table key when both bounds
+  // default to the table's domain).
+  SourceRange bounds_range;
+  // Difficulty measure D = (L_D, {axes}); the paper's regions: (2, {x, y}).
+  // The loader accepts any of x, y, z, u (level = number of distinct axes);
+  // the compiler's regions pass refuses a region it cannot serve.
+  int difficulty_level = 0;
+  std::vector<TaskAxis> difficulty_axes;  // as written, no duplicates
+  SourceRange difficulty_range;
+  std::string table_path;  // as written, relative to the cell file
+  SourceRange table_range;
+  ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
+  Rect domain;             // TableDomain(table): where F is defined
+  double tolerance_mm = 0;  // the task tolerance: +- this around the required position
+  SourceRange tolerance_range;
+  OutsidePolicy outside = OutsidePolicy::kError;  // policy for points outside the grid
+  SourceRange outside_range;  // the outside key (the [[region]] table when defaulted)
+  SourceRange range;  // the [[region]] table
+
+  bool Contains(const Point2& p) const { return x_mm.Contains(p.x()) && y_mm.Contains(p.y()); }
+};
+
+// A straight marker edge, as the segment of it the sensor can see, in fixture
+// coordinates. The edge's line (p1..p4 in the paper) is its infinite extension.
+struct MarkerEdge {
+  std::string name;  // p1, p2, p3, p4
+  Point2 from = Point2::Zero();
+  Point2 to = Point2::Zero();
+  SourceRange range;  // the edge's key in [fixture.edges]
+};
+
+// A V-shaped scan path in fixture coordinates: a polyline the sensor moves
+// along at the scan height; where a leg crosses a marker edge the sensor trips.
+// The trips are numbered T1, T2, ... in the order the paths meet them (first
+// path first); ExpectedTrips() in calibration/fixture_geometry.h lists them.
+struct ScanPath {
+  std::string name;
+  std::vector<Point2> points;  // at least 2, consecutive points distinct
+  std::vector<SourceRange> point_ranges;  // one per point: its [x, y]
+  SourceRange range;           // the [[fixture.scan_path]] table
+};
+
+enum class Estimator { kPaper, kRigid, kRigidScale };
+
+// [[fixture]]
+struct Fixture {
+  std::string name;  // bound to the program's `Fixture NAME` (case-insensitive)
+  SourceRange name_range;
+  // Nominal pose of the fixture frame in the robot base frame: origin S1 and
+  // the angle of its x axis (n) against the base x axis.
+  Point2 origin_mm = Point2::Zero();
+  double angle_deg = 0;
+  SourceRange pose_range;  // the origin_mm key
+  double l1_mm = 0;  // |S2 - S1|, measured when the board was made
+  double l2_mm = 0;  // |S3 - S1|
+  // The four marker edges: S1 = p1 x p2, S2 = p1 x p3, S3 = p2 x p4 (see
+  // docs/cell.md for the paper cell's layout), in that order. The loader has
+  // checked that the lines cross at (0,0), (L1,0) and (0,L2) within
+  // kMarkerGeometryTolMm.
+  std::array<MarkerEdge, 4> edges;
+  std::vector<ScanPath> scan_paths;  // at least one; every edge crossed at least twice
+  double scan_z_mm = 0;          // sensor height over the markers (robot z)
+  double scan_speed_mm_s = 0;    // feed along the scan paths
+  double trip_window_mm = 0;     // a trip is expected within this distance of its nominal point along the leg
+  int sensor_input = 0;          // digital input the sensor is wired to
+  double sensor_accuracy_mm = 0; // +- where the sensor trips against the true edge
+  Estimator estimator = Estimator::kPaper;
+  // Check limits (all > 0).
+  double max_shift_mm = 0;        // |p_n - p_{n-1}| per cycle, and |p - nominal| at any cycle
+  double max_rotation_deg = 0;    // |angle_n - angle_{n-1}| per cycle, and against nominal
+  double length_tolerance_mm = 0; // | |S2-S1| - L1 | and | |S3-S1| - L2 |
+  double squareness_deg = 0;      // | angle(S2-S1, S3-S1) - 90 deg |
+  double max_line_residual_mm = 0;  // largest distance of a trip from its fitted line
+  // The teach-time scan that gives FIX_0 for taught points: trips T1..Tn in
+  // robot base coordinates as commanded when the sensor tripped. Empty when the
+  // cell has none (then a taught point on this fixture is an error). When
+  // given, there is one per nominal trip, each within trip_window_mm of where
+  // the nominal pose puts its nominal trip.
+  std::vector<Point2> teach_trips_mm;
+  std::vector<SourceRange> teach_trip_ranges;  // one per trip: its [x, y]
+  SourceRange teach_range;  // the teach_trips_mm key (the [[fixture]] table when absent)
+  SourceRange range;  // the [[fixture]] table
+};
+
+// [[feeder]]: a named pick point in the robot base frame, optionally a pallet
+// of pick points (columns along from -> last, rows along from -> back).
+struct Feeder {
+  std::string name;
+  SourceRange name_range;
+  std::array<double, 4> pick{};  // x, y, z mm, u deg
+  std::optional<std::array<double, 4>> pallet_last;  // the last column of the first row
+  std::optional<std::array<double, 4>> pallet_back;  // the first column of the last row
+  int columns = 1;
+  int rows = 1;
+  // Which parts it holds, for CAD import: package and/or value; empty = any.
+  // `package` may be written as an array of names (a bank of mixed lanes):
+  // `packages` holds them all and `package` the first one, so a feeder with
+  // one package has package == packages[0]. Match against `packages`.
+  std::string package;
+  std::vector<std::string> packages;
+  std::string value;
+  SourceRange range;  // the [[feeder]] table
+};
+
+// [linuxcnc]: how the cell's LinuxCNC controller is wired, for
+// `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that
+// target needs it (and reports its absence).
+struct LinuxCnc {
+  char rotation_axis = 'C';      // the axis word u is commanded on: A, B or C
+  int vacuum_sensor_input = 0;   // motion.digital-in-NN the gripper's vacuum sensor is wired to
+  double vacuum_timeout_s = 0;   // how long a Pick/Place waits for the sensor before aborting (> 0)
+  SourceRange range;             // the [linuxcnc] table
+};
+
+// LinuxCNC's motion controller has at most 64 digital inputs and outputs
+// (motion.digital-in/out-00..63, [EMCMOT]num_dio).
+inline constexpr int kLinuxCncMaxDio = 64;
+
+struct Cell {
+  std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
+  std::string path;    // the cell file as given
+  std::uint32_t file = 0;  // its SourceManager id
+  Robot robot;
+  std::vector<Region> regions;  // pairwise without common interior (they may share an edge)
+  std::vector<Fixture> fixtures;
+  std::vector<Feeder> feeders;
+  std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
+
+  const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
+  const Region* FindRegion(std::string_view name) const;    // case-insensitive
+  const Feeder* FindFeeder(std::string_view name) const;    // case-insensitive
+  // The region whose bounds contain the required position p: regions do not
+  // overlap, so there is at most one, except on an edge two regions share,
+  // which belongs to the one listed first in the file. nullptr if none.
+  const Region* RegionAt(const Point2& p) const;
+};
+
+// The names as the file writes them, in the order of their enums.
+inline constexpr std::array<std::string_view, 4> kTaskAxisNames = {"x", "y", "z", "u"};
+static_assert(static_cast<int>(TaskAxis::U) == 3);
+inline constexpr std::array<std::string_view, 3> kEstimatorNames = {"paper", "rigid", "rigid-scale"};
+static_assert(static_cast<int>(Estimator::kRigidScale) == 2);
+inline constexpr std::array<std::string_view, 3> kOutsideNames = {"error", "clamp", "none"};
+static_assert(static_cast<int>(OutsidePolicy::kClamp) == 1 && static_cast<int>(OutsidePolicy::kNone) == 2);
+
+std::string_view EstimatorName(Estimator estimator);  // paper | rigid | rigid-scale
+std::string_view TaskAxisName(TaskAxis axis);         // x | y | z | u
+std::string_view OutsidePolicyName(OutsidePolicy policy);  // error | clamp | none
+
+}  // namespace smtcal::cell

@@ -1,0 +1,56 @@
+// Building an error table from raw measurements (`smtcal table build`): the
+// paper averaged two sets of ten measurements per node and axis. Every node's
+// mean is stored with the stddev and the count of its measurements; nodes
+// whose scatter is far above the rest of their axis, and nodes whose sets
+// disagree, are reported instead of being averaged silently.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "calibration/error_table.h"
+
+namespace smtcal {
+
+// One row of a raw measurement file: axis,x_mm,y_mm,set,repetition,error_mm.
+struct RawMeasurement {
+  TableAxis axis = TableAxis::X;
+  double x_mm = 0;
+  double y_mm = 0;
+  long long set = 0;
+  long long repetition = 0;
+  double error_mm = 0;
+  SourceRange x_field;  // for "node ... is here"
+  SourceRange y_field;
+  SourceRange repetition_field;
+  SourceRange error_field;
+};
+
+// The statistics of one node's measurements.
+struct NodeSummary {
+  TableAxis axis = TableAxis::X;
+  double x_mm = 0, y_mm = 0;
+  std::vector<std::size_t> rows;  // indices into the measurements, in file order
+  double mean_mm = 0;
+  std::optional<double> stddev_mm;         // sample stddev of all measurements (n >= 2)
+  std::optional<double> pooled_stddev_mm;  // pooled within-set stddev (repetition scatter)
+  double set_mean_spread_mm = 0;           // largest minus smallest set mean (sets of 2 or more)
+  // sqrt(1/n_low + 1/n_high): the spread's standard error per unit of
+  // repetition scatter (given when there are two such sets and a pooled stddev).
+  std::optional<double> set_spread_weight;
+};
+
+// Groups measurements by node and summarizes each (sorted by axis, x, y).
+// Reports a repetition given twice.
+std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measurements,
+                                        Diagnostics& diags);
+
+// The whole build: summaries, warnings for noisy nodes and set shifts, and
+// the table assembled from the node means (AssembleErrorTable's checks).
+// Validation (ValidateErrorTable) is the caller's next step. nullopt on errors.
+std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& measurements,
+                                          SourceLoc file, Diagnostics& diags);
+
+}  // namespace smtcal

@@ -1,0 +1,77 @@
+// Altium Designer pick-and-place reports, text (.txt) and CSV:
+//
+//   Altium Designer Pick and Place Locations
+//   <project path>
+//   ====...
+//   File Design Information:
+//   Date: ...   Units used: mil
+//   Designator Comment Layer    Footprint Center-X(mil) Center-Y(mil) Rotation Description
+//   J1         53261   TopLayer MOLEX-... 175.000       470.000       270      "Male Header, ..."
+//
+// The CSV report has the same lines with every field quoted. The text
+// report pads its columns with spaces; rows are split at blanks (quoted
+// descriptions kept whole), and a row whose words do not match the header
+// (a Comment with a space in it) is cut at the header's column positions.
+// Older reports (Protel, DXP) have "Mid X  Mid Y  Ref X  Ref Y  Pad X  Pad Y
+// TB" columns with the unit written after every value ("1190mil"): the
+// part's centre is Mid X/Y (Center-X/Y in newer reports), Ref is the
+// footprint origin and Pad pin 1, read only when the centre is missing.
+#include <fmt/format.h>
+
+#include "frontend/cad/cad_table.h"
+
+namespace smtcal::cad {
+namespace {
+
+// "Units used: mil" (possibly quoted, in the CSV report).
+bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<StatedUnit>& unit, Diagnostics& diags) {
+  std::string_view text = lines.Text(number);
+  constexpr std::string_view kKey = "Units used:";
+  std::size_t key = text.find(kKey);
+  if (key == std::string_view::npos) return true;
+  std::size_t begin = text.find_first_not_of(" \t", key + kKey.size());
+  if (begin == std::string_view::npos) return true;
+  std::size_t end = text.find_first_of(" \t\",", begin);
+  if (end == std::string_view::npos) end = text.size();
+  std::string_view word = text.substr(begin, end - begin);
+  std::optional<LengthUnit> parsed = UnitFromName(word);
+  if (!parsed) {
+    diags.Report(DiagKind::CadUnknownUnit, lines.Range(number, begin, word.size()), Printable(word),
+                 " in the report's 'Units used'");
+    return false;
+  }
+  unit = StatedUnit{*parsed, lines.Range(number, begin, word.size())};
+  return true;
+}
+
+}  // namespace
+
+Dialect AltiumDialect() {
+  Dialect dialect;
+  dialect.format = Format::kAltium;
+  dialect.aliases = {
+      {"designator", "Designator", Column::kDesignator, 0},
+      {"comment", "Comment", Column::kValue, 0},
+      {"footprint", "Footprint", Column::kPackage, 0},
+      {"centerx", "Center-X", Column::kX, 0},
+      {"midx", "Mid X", Column::kX, 0},
+      {"refx", "Ref X", Column::kX, 1},
+      {"padx", "Pad X", Column::kX, 2},
+      {"centery", "Center-Y", Column::kY, 0},
+      {"midy", "Mid Y", Column::kY, 0},
+      {"refy", "Ref Y", Column::kY, 1},
+      {"pady", "Pad Y", Column::kY, 2},
+      {"rotation", "Rotation", Column::kRotation, 0},
+      {"layer", "Layer", Column::kSide, 0},
+      {"tb", "TB", Column::kSide, 0},
+      {"dnp", "DNP", Column::kDnp, 0},
+  };
+  for (Column c : {Column::kDesignator, Column::kX, Column::kY, Column::kRotation}) {
+    dialect.required[static_cast<int>(c)] = true;
+  }
+  dialect.fixed_width = true;
+  dialect.preamble = AltiumUnitLine;
+  return dialect;
+}
+
+}  // namespace smtcal::cad

@@ -1,0 +1,644 @@
+// From CAD rows to a .place program (see cad_to_program.h).
+//
+// Assumes: rows as the readers give them (lengths in mm, rotations in
+// degrees as the list writes them), a feeder table whose rules are resolved,
+// options checked by the command line (|rotation| <= 360, columns and rows
+// >= 1, a valid program name, a fixture of the cell).
+// Guarantees: every row ends as a placement or a diagnostic at its line;
+// the program it returns passes the IR verifier and, printed, is canonical
+// and clean under the check passes (names unique and valid, every point's
+// frame declared, pallets 0..15, rotations within one turn).
+#include "frontend/cad/cad_to_program.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+#include "base/field_text.h"
+#include "calibration/limits.h"
+#include "calibration/tolerances.h"
+#include "frontend/cad/cad_text.h"
+
+namespace smtcal {
+namespace {
+
+// The .place keywords (docs/language.md, "Lexical rules"); a name may not be one.
+constexpr std::string_view kKeywords[] = {
+    "and",   "call",  "cycle", "else",   "elseif", "endcycle", "endif",   "exit",  "fend",  "fixture", "for",
+    "function", "go", "if",    "in",     "integer", "jump",    "limz",    "local", "mod",   "move",    "next",
+    "not",   "off",   "on",    "or",     "pallet", "pick",     "place",   "point", "program", "real",  "scan",
+    "step",  "sw",    "taught", "then",  "to",     "units",    "vacuum",  "wait",  "xor",   "xy"};
+
+bool IsKeyword(std::string_view name) {
+  std::string lower = AsciiLowercase(name);
+  return std::find(std::begin(kKeywords), std::end(kKeywords), lower) != std::end(kKeywords);
+}
+
+// Text for a comment: one line, no control characters, valid UTF-8, no
+// trailing blanks (the canonical form drops them).
+std::string CommentText(std::string_view text) {
+  if (std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; })) {
+    std::string out(text);  // the common case: printable ASCII
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    return out;
+  }
+  std::string out = Printable(text);
+  // Printable shows control bytes as \xNN; a tab or line end in a value
+  // reads better as a space.
+  for (std::string_view control : {"\\x09", "\\x0a", "\\x0d"}) {
+    for (std::size_t at; (at = out.find(control)) != std::string::npos;) out.replace(at, control.size(), " ");
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
+double Round(double value, double resolution) {
+  const double scale = std::round(1.0 / resolution);
+  double rounded = std::round(value * scale) / scale;
+  return rounded == 0 ? 0.0 : rounded;  // no -0.0
+}
+
+double NormaliseAngle(double degrees, AngleRange range) {
+  double u = std::fmod(degrees, 360.0);
+  if (range == AngleRange::kPositive) {
+    if (u < 0) u += 360.0;
+    if (Round(u, kCadResolutionDeg) >= 360.0) u = 0;
+  } else {
+    if (u <= -180.0) u += 360.0;
+    if (u > 180.0) u -= 360.0;
+    if (Round(u, kCadResolutionDeg) <= -180.0) u = 180.0;
+  }
+  return Round(u, kCadResolutionDeg);
+}
+
+// Values and packages that mean "do not place" (any case).
+bool IsDnpValue(std::string_view value) {
+  std::string lower = AsciiLowercase(value);
+  for (std::string_view mark : {"dnp", "dnf", "dni", "nf", "np", "nopop", "no pop", "do not place",
+                                "do not populate", "do not fit", "not fitted", "not populated"}) {
+    if (lower == mark) return true;
+  }
+  return false;
+}
+
+// Pallets are numbered from 1, as a person numbers feeder banks (SPEL+'s
+// pallet 0 is left free).
+constexpr int kFirstPallet = 1;
+
+// The exclusions smtcal makes unless told otherwise: fiducials and
+// mounting holes are not parts a robot picks.
+const std::vector<std::string> kDefaultExcludedDesignators = {"FID*"};
+const std::vector<std::string> kDefaultExcludedPackages = {"*Fiducial*", "*MountingHole*"};
+
+ir::StmtPtr MakeStmt(SourceLoc loc, auto node, std::string comment = {}) {
+  auto stmt = std::make_unique<ir::Stmt>();
+  stmt->loc = loc;
+  stmt->node = std::move(node);
+  stmt->trailing_comment = std::move(comment);
+  return stmt;
+}
+
+ir::StmtPtr CommentStmt(SourceLoc loc, std::string_view text, bool blank_before = false) {
+  ir::StmtPtr stmt = MakeStmt(loc, ir::Comment{text.empty() ? std::string() : " " + CommentText(text)});
+  stmt->blank_line_before = blank_before;
+  return stmt;
+}
+
+ir::Coords MakeCoords(SourceLoc loc, std::array<double, 4> values) {
+  ir::Coords coords;
+  coords.loc = loc;
+  coords.values = values;
+  return coords;
+}
+
+ir::ExprPtr IntLit(SourceLoc loc, int value) {
+  auto expr = std::make_unique<ir::Expr>();
+  expr->loc = loc;
+  expr->length = static_cast<std::uint32_t>(std::to_string(value).size());
+  expr->node = ir::NumberLit{static_cast<double>(value), true};
+  return expr;
+}
+
+// What a name in the program is, described only when a collision is
+// reported (building a sentence per part would dominate a large import).
+struct NameOwner {
+  std::string_view what;  // "the fixture", "the pick point of feeder", "the point of"
+  std::string_view name;  // the feeder or designator (empty for the others)
+  std::uint32_t line = 0;  // the part's line
+  std::string Describe() const {
+    if (name.empty()) return std::string(what);
+    std::string text = fmt::format("{} '{}'", what, Printable(name));
+    if (line != 0) text += fmt::format(" (line {})", line);
+    return text;
+  }
+};
+
+// Unique names in the program's one namespace (case-insensitive). An open-
+// addressing table over the names as written: a large import makes one name
+// per part and board, and a node-based map's allocation per name would cost
+// more than the rest of building the program.
+class NameTable {
+ public:
+  explicit NameTable(std::size_t expected) {
+    std::size_t slots = 64;
+    while (slots < 2 * expected) slots *= 2;
+    slots_.assign(slots, kEmpty);
+    entries_.reserve(expected);
+  }
+
+  // `wanted` if free, else wanted_2, wanted_3, ...; `taken_by` tells who
+  // had `wanted`.
+  std::string Claim(const std::string& wanted, NameOwner owner, std::optional<NameOwner>* taken_by = nullptr) {
+    if (const NameOwner* existing = Insert(wanted, owner)) {
+      if (taken_by != nullptr) *taken_by = *existing;
+      for (int k = 2;; ++k) {
+        std::string name = fmt::format("{}_{}", wanted, k);
+        if (Insert(name, owner) == nullptr) return name;
+      }
+    }
+    return wanted;
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffff;
+  struct Entry {
+    std::string name;
+    NameOwner owner;
+  };
+
+  static char AsciiLowercase(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+  static std::size_t Hash(std::string_view name) {
+    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
+    for (char c : name) hash = (hash ^ static_cast<unsigned char>(AsciiLowercase(c))) * 1099511628211ull;
+    return static_cast<std::size_t>(hash);
+  }
+  static bool Same(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (AsciiLowercase(a[i]) != AsciiLowercase(b[i])) return false;
+    }
+    return true;
+  }
+
+  // Adds `name`, or returns the owner that already has it.
+  const NameOwner* Insert(const std::string& name, const NameOwner& owner) {
+    if (2 * (entries_.size() + 1) > slots_.size()) Grow();
+    std::size_t mask = slots_.size() - 1;
+    for (std::size_t slot = Hash(name) & mask;; slot = (slot + 1) & mask) {
+      if (slots_[slot] == kEmpty) {
+        slots_[slot] = static_cast<std::uint32_t>(entries_.size());
+        entries_.push_back({name, owner});
+        return nullptr;
+      }
+      const Entry& entry = entries_[slots_[slot]];
+      if (Same(entry.name, name)) return &entry.owner;
+    }
+  }
+
+  void Grow() {
+    slots_.assign(slots_.size() * 2, kEmpty);
+    std::size_t mask = slots_.size() - 1;
+    for (std::uint32_t e = 0; e < entries_.size(); ++e) {
+      std::size_t slot = Hash(entries_[e].name) & mask;
+      while (slots_[slot] != kEmpty) slot = (slot + 1) & mask;
+      slots_[slot] = e;
+    }
+  }
+
+  std::vector<std::uint32_t> slots_;
+  std::vector<Entry> entries_;
+};
+
+// 'text' for a message, or "none" when the list gives none.
+std::string Quoted(std::string_view text) {
+  return text.empty() ? std::string("none") : fmt::format("'{}'", Printable(text));
+}
+
+// "C1 10uF C_0805_2012Metric": what a part is, for its trailing comments.
+template <typename Part>
+std::string PartComment(const Part& part) {
+  std::string text = CommentText(part.designator);
+  for (const std::string* field : {&part.value, &part.package}) {
+    std::string more = CommentText(*field);
+    if (!more.empty()) text += " " + more;
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string MakeIdentifier(std::string_view text) {
+  std::string name;
+  for (char c : text) {
+    bool word = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+    // A multi-byte UTF-8 character becomes one '_', not one per byte.
+    if (!word && (static_cast<unsigned char>(c) & 0xc0) == 0x80) continue;
+    name += word ? c : '_';
+  }
+  if (name.empty() || (name.front() >= '0' && name.front() <= '9')) name.insert(name.begin(), '_');
+  if (IsKeyword(name)) name += '_';
+  return name;
+}
+
+std::string_view SkipReasonName(SkipReason reason) {
+  switch (reason) {
+    case SkipReason::kOtherSide: return "on the other side";
+    case SkipReason::kDnp: return "do-not-place";
+    case SkipReason::kExcluded: return "excluded";
+    case SkipReason::kUnmapped: return "no feeder";
+    case SkipReason::kCount: break;
+  }
+  return "?";
+}
+
+std::string FormatImportSummary(const ImportSummary& s) {
+  std::string text = fmt::format("import: {} row{} read ({})", s.rows_read, s.rows_read == 1 ? "" : "s", s.format);
+  if (s.rows_with_errors > 0) text += fmt::format(", {} with errors", s.rows_with_errors);
+  text += '\n';
+  if (s.failed) {
+    text += "  placed:  nothing (see the errors above)\n";
+  } else {
+    text += fmt::format("  placed:  {} part{}", s.parts_placed, s.parts_placed == 1 ? "" : "s");
+    if (s.boards > 1) text += fmt::format(" on each of {} boards ({} placements)", s.boards, s.parts_placed * s.boards);
+    text += fmt::format(" from {} feeder{}\n", s.feeders_used, s.feeders_used == 1 ? "" : "s");
+  }
+  std::size_t skipped = 0;
+  std::string reasons;
+  for (int r = 0; r < static_cast<int>(SkipReason::kCount); ++r) {
+    if (s.skipped[r] == 0) continue;
+    skipped += s.skipped[r];
+    reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", s.skipped[r], SkipReasonName(static_cast<SkipReason>(r)));
+  }
+  text += fmt::format("  skipped: {}{}\n", skipped, reasons.empty() ? "" : " (" + reasons + ")");
+  return text;
+}
+
+CadImporter::CadImporter(const cad::FeederTable& feeders, ImportOptions options, std::uint32_t list_file,
+                         Diagnostics& diags)
+    : feeders_(feeders), options_(std::move(options)), list_file_(list_file), diags_(diags) {
+  summary_.boards = static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows);
+}
+
+bool CadImporter::Classify(const cad::Row& row, Part& part) {
+  if (!options_.keep_dnp && (row.dnp || IsDnpValue(row.value))) {
+    part.skip = SkipReason::kDnp;
+    part.skip_detail = static_cast<int>(skip_details_.size());
+    skip_details_.push_back({row.dnp ? "the DNP column" : fmt::format("its value '{}'", Printable(row.value))});
+    part.skip_range = row.dnp ? row.dnp_range : row.value_range;
+    return true;
+  }
+  auto match = [&](const std::vector<std::string>& patterns, std::string_view field, std::string_view text,
+                   const SourceRange& range, std::string_view rule) {
+    for (const std::string& pattern : patterns) {
+      if (!cad::GlobMatch(pattern, text)) continue;
+      part.skip = SkipReason::kExcluded;
+      part.skip_detail = static_cast<int>(skip_details_.size());
+      skip_details_.push_back({std::string(field), Printable(text), std::string(rule), Printable(pattern)});
+      part.skip_range = range;
+      return true;
+    }
+    return false;
+  };
+  if (match(options_.exclude_designators, "designator", row.designator, row.designator_range, "--exclude-designator") ||
+      match(options_.exclude_packages, "package", row.package, row.package_range, "--exclude-package")) {
+    return true;
+  }
+  if (!options_.default_excludes) return false;
+  return match(kDefaultExcludedDesignators, "designator", row.designator, row.designator_range,
+               "the default exclusion") ||
+         match(kDefaultExcludedPackages, "package", row.package, row.package_range, "the default exclusion");
+}
+
+std::optional<cad::FeederMatch> CadImporter::FindFeeder(const cad::Row& row) {
+  if (feeders_.matches_designators()) return feeders_.Find(row);
+  cache_key_.assign(row.package);
+  cache_key_ += '\0';
+  cache_key_ += row.value;
+  auto it = feeder_cache_.find(cache_key_);
+  if (it != feeder_cache_.end()) return it->second;
+  std::optional<cad::FeederMatch> match = feeders_.Find(row);
+  feeder_cache_.emplace(cache_key_, match);
+  return match;
+}
+
+void CadImporter::Add(const cad::Row& row) {
+  Part part;
+  part.line = row.line;
+  part.designator = row.designator;
+  part.value = row.value;
+  part.package = row.package;
+  part.x_mm = row.x_mm;
+  part.y_mm = row.y_mm;
+  part.rotation_deg = row.rotation_deg;
+  part.side = row.side;
+  part.designator_range = row.designator_range;
+  part.side_range = row.side_range;
+  if (!Classify(row, part)) part.feeder = FindFeeder(row);
+  parts_.push_back(std::move(part));
+}
+
+void CadImporter::ReportSkip(const Part& part, cad::Side placed_side) {
+  std::string designator = Printable(part.designator);
+  if (part.side != placed_side) {
+    diags_.Report(DiagKind::ImportSkippedSide, part.side_range, designator, cad::SideName(part.side),
+                  cad::SideName(placed_side));
+    ++summary_.skipped[static_cast<int>(SkipReason::kOtherSide)];
+  } else if (part.skip == SkipReason::kDnp) {
+    diags_.Report(DiagKind::ImportSkippedDnp, part.skip_range, designator, skip_details_[part.skip_detail][0]);
+    ++summary_.skipped[static_cast<int>(SkipReason::kDnp)];
+  } else if (part.skip == SkipReason::kExcluded) {
+    const std::array<std::string, 4>& detail = skip_details_[part.skip_detail];
+    diags_.Report(DiagKind::ImportExcluded, part.skip_range, designator, detail[0], detail[1], detail[2], detail[3]);
+    ++summary_.skipped[static_cast<int>(SkipReason::kExcluded)];
+  } else {
+    diags_.Report(DiagKind::ImportSkippedUnmapped, part.designator_range, designator, Quoted(part.package),
+                  Quoted(part.value));
+    ++summary_.skipped[static_cast<int>(SkipReason::kUnmapped)];
+  }
+}
+
+void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
+  // One group per package and value, in the order they first appear.
+  std::vector<std::vector<const Part*>> groups;
+  std::map<std::pair<std::string, std::string>, std::size_t> group_of;
+  for (const Part* part : unmapped) {
+    auto [it, fresh] = group_of.emplace(std::make_pair(part->package, part->value), groups.size());
+    if (fresh) groups.emplace_back();
+    groups[it->second].push_back(part);
+  }
+  Diagnostic* error = diags_.Report(DiagKind::ImportUnmappedParts, unmapped.front()->designator_range,
+                                    unmapped.size(), unmapped.size() == 1 ? "part has" : "parts have", groups.size(),
+                                    groups.size() == 1 ? "kind" : "kinds");
+  constexpr std::size_t kNamesShown = 8;  // designators listed per kind; the count says the rest
+  for (const std::vector<const Part*>& group : groups) {
+    std::string names;
+    for (std::size_t i = 0; i < group.size() && i < kNamesShown; ++i) {
+      names += (i == 0 ? "" : ", ") + Printable(group[i]->designator);
+    }
+    if (group.size() > kNamesShown) names += ", ...";
+    Diagnostics::AddNote(error, group.front()->designator_range,
+                         fmt::format("package {}, value {}: {} part{} ({})", Quoted(group.front()->package),
+                                     Quoted(group.front()->value), group.size(), group.size() == 1 ? "" : "s", names));
+  }
+}
+
+std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
+  summary_.rows_read = reader.rows_read();
+  summary_.rows_with_errors = reader.rows_with_errors();
+  summary_.format = fmt::format("{}, {}", cad::FormatTitle(reader.format()), cad::UnitName(reader.unit()));
+  const SourceRange list_start(SourceLoc{list_file_, 1, 1});
+
+  // The side: as asked, or the only one the list places parts on.
+  std::array<std::size_t, 2> on_side{};
+  std::array<const Part*, 2> first_on_side{};
+  for (const Part& part : parts_) {
+    if (part.skip) continue;
+    int s = static_cast<int>(part.side);
+    if (on_side[s]++ == 0) first_on_side[s] = &part;
+  }
+  cad::Side side = options_.side.value_or(on_side[1] > 0 && on_side[0] == 0 ? cad::Side::kBottom : cad::Side::kTop);
+  if (!options_.side && on_side[0] > 0 && on_side[1] > 0) {
+    int minority = on_side[1] <= on_side[0] ? 1 : 0;
+    diags_.Report(DiagKind::ImportMixedSides, first_on_side[minority]->side_range, on_side[0], on_side[1]);
+    summary_.failed = true;
+    return std::nullopt;
+  }
+
+  std::vector<const Part*> placed, unmapped;
+  for (const Part& part : parts_) {
+    if (part.side != side || part.skip) {
+      ReportSkip(part, side);
+    } else if (!part.feeder) {
+      if (options_.skip_unmapped) {
+        ReportSkip(part, side);
+      } else {
+        unmapped.push_back(&part);
+      }
+    } else {
+      placed.push_back(&part);
+    }
+  }
+  summary_.parts_placed = placed.size();
+  if (!unmapped.empty()) {
+    ReportUnmapped(unmapped);
+    summary_.failed = true;
+    return std::nullopt;
+  }
+  if (placed.empty()) {
+    if (summary_.rows_read == 0) {
+      diags_.Report(DiagKind::CadNoRows, list_start, cad::FormatTitle(reader.format()));
+    } else if (summary_.rows_with_errors == 0) {
+      std::size_t rows = summary_.rows_read;
+      diags_.Report(DiagKind::ImportNothingToPlace, list_start, rows, rows == 1 ? "row" : "rows");
+    }
+    summary_.failed = true;
+    return std::nullopt;
+  }
+  std::optional<ir::Program> program = Build(placed, side);
+  std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
+  if (!program || diags_.has_errors()) {
+    summary_.failed = true;
+    return std::nullopt;
+  }
+  return program;
+}
+
+std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side) {
+  const SourceLoc start{list_file_, 1, 1};
+  const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
+  NameTable names(parts.size() * static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows) +
+                  2 * feeders.size() + 64);
+  names.Claim(options_.fixture, {"the fixture", {}, 0});
+  names.Claim("Main", {"the function Main", {}, 0});
+
+  ir::Program program;
+  program.file = list_file_;
+  ir::Block& items = program.items;
+  for (const std::string& line : options_.header_lines) items.push_back(CommentStmt(start, line));
+  items.push_back(MakeStmt(start, ir::ProgramDecl{options_.program_name, start}));
+  items.push_back(MakeStmt(start, ir::UnitsDecl{"mm", start}));
+  items.push_back(MakeStmt(start, ir::FixtureDecl{options_.fixture, start}));
+  items.push_back(MakeStmt(start, ir::VacuumDecl{options_.vacuum, start}, " the gripper's vacuum output (--vacuum)"));
+
+  // --- the boards of the panel, row by row from the origin --------------
+  const double angle = options_.rotation_deg * std::numbers::pi / 180.0;
+  std::vector<std::string> boards;
+  std::string board_text = fmt::format("origin ({}, {}) mm, rotated {}°", options_.origin_x_mm, options_.origin_y_mm,
+                                       options_.rotation_deg);
+  const bool panel = options_.columns * options_.rows > 1;
+  items.push_back(CommentStmt(
+      start,
+      panel ? fmt::format("A panel of {} x {} boards in fixture {}: {}, pitch ({}, {}) mm", options_.columns, options_.rows,
+                          options_.fixture, board_text, options_.pitch_x_mm, options_.pitch_y_mm)
+            : fmt::format("The board in fixture {}: {}", options_.fixture, board_text),
+      true));
+  for (int r = 0; r < options_.rows; ++r) {
+    for (int c = 0; c < options_.columns; ++c) {
+      double dx = c * options_.pitch_x_mm, dy = r * options_.pitch_y_mm;
+      double x = Round(options_.origin_x_mm + std::cos(angle) * dx - std::sin(angle) * dy, kCadResolutionMm);
+      double y = Round(options_.origin_y_mm + std::sin(angle) * dx + std::cos(angle) * dy, kCadResolutionMm);
+      std::string name = names.Claim(panel ? fmt::format("Pcb{}", boards.size() + 1) : "Pcb", {"a board frame", {}, 0});
+      ir::LocalDecl local{name, start, MakeCoords(start, {x, y, 0.0, Round(options_.rotation_deg, kCadResolutionDeg)}),
+                          options_.fixture, start};
+      items.push_back(MakeStmt(start, std::move(local),
+                               panel ? fmt::format(" column {}, row {}", c + 1, r + 1) : std::string()));
+      boards.push_back(name);
+    }
+  }
+
+  // --- the feeders the parts use, in the feeder table's order ------------
+  std::vector<std::vector<std::size_t>> by_feeder(feeders.size());  // indices into parts
+  for (std::size_t i = 0; i < parts.size(); ++i) by_feeder[parts[i]->feeder->feeder].push_back(i);
+  std::vector<std::string> pick_name(feeders.size());  // a point, or empty for a pallet
+  std::vector<int> pallet_number(feeders.size(), 0);
+  int next_pallet = kFirstPallet;
+  bool first_feeder = true;
+  for (std::size_t f = 0; f < feeders.size(); ++f) {
+    if (by_feeder[f].empty()) continue;
+    ++summary_.feeders_used;
+    const cad::FeederSpec& feeder = feeders[f];
+    SourceLoc loc = feeder.name_range.begin.known() ? feeder.name_range.begin : start;
+    const NameOwner owner{"the pick point of feeder", feeder.name, 0};
+    std::string comment = fmt::format(" feeder {}{}", CommentText(feeder.name), feeder.from_cell ? " (cell)" : "");
+    if (first_feeder) items.push_back(CommentStmt(start, "The feeders' pick points (robot base frame)", true));
+    first_feeder = false;
+    std::string base = MakeIdentifier(feeder.name);
+    if (!feeder.is_pallet()) {
+      pick_name[f] = names.Claim(base, owner);
+      items.push_back(MakeStmt(loc, ir::PointDecl{pick_name[f], loc, false, MakeCoords(loc, feeder.pick), "", {}},
+                               comment));
+      continue;
+    }
+    if (next_pallet > limits::kPalletNumberMax) {
+      diags_.Report(DiagKind::ImportTooManyPallets, feeder.name_range, Printable(feeder.name), next_pallet,
+                    kFirstPallet, limits::kPalletNumberMax);
+      continue;
+    }
+    pallet_number[f] = next_pallet++;
+    std::array<std::string, 3> corners = {names.Claim(base + "First", owner), names.Claim(base + "Last", owner),
+                                          names.Claim(base + "Back", owner)};
+    const std::array<std::array<double, 4>, 3> where = {feeder.pick, *feeder.pallet_last,
+                                                        feeder.pallet_back.value_or(feeder.pick)};
+    for (std::size_t k = 0; k < 3; ++k) {
+      items.push_back(MakeStmt(loc, ir::PointDecl{corners[k], loc, false, MakeCoords(loc, where[k]), "", {}}));
+    }
+    ir::PalletDecl pallet;
+    pallet.number = pallet_number[f];
+    pallet.number_loc = loc;
+    pallet.corners = corners;
+    pallet.corner_locs = {loc, loc, loc};
+    pallet.columns = feeder.columns;
+    pallet.columns_loc = loc;
+    pallet.rows = feeder.rows;
+    pallet.rows_loc = loc;
+    items.push_back(MakeStmt(loc, std::move(pallet), comment));
+  }
+
+  // --- the parts, board by board -----------------------------------------
+  const ImportMirror mirror = options_.mirror.value_or(side == cad::Side::kBottom ? ImportMirror::kX : ImportMirror::kNone);
+  const bool mirror_rotation =
+      mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
+  std::string how = mirror == ImportMirror::kX   ? ", turned over: x negated"
+                    : mirror == ImportMirror::kY ? ", turned over: y negated"
+                                                 : "";
+  std::vector<std::string> comments;  // per part: " C1 100n C_0603"
+  comments.reserve(parts.size());
+  for (const Part* part : parts) comments.push_back(" " + PartComment(*part));
+  // point_name[b][i]: the point of part i on board b.
+  std::vector<std::vector<std::string>> point_name(boards.size(), std::vector<std::string>(parts.size()));
+  for (std::size_t b = 0; b < boards.size(); ++b) {
+    items.push_back(CommentStmt(start,
+                                fmt::format("The parts on the {} side{}, in {} (board coordinates, mm)",
+                                            cad::SideName(side), how, boards[b]),
+                                true));
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const Part& part = *parts[i];
+      const SourceLoc loc = part.designator_range.begin;
+      const std::string wanted = panel ? boards[b] + "_" + MakeIdentifier(part.designator) : MakeIdentifier(part.designator);
+      std::optional<NameOwner> taken;
+      const std::string name = names.Claim(wanted, {"the point of", part.designator, part.line}, &taken);
+      // Equal designators make equal names, so a duplicate shows as a
+      // collision with the point of the same designator.
+      if (b == 0 && taken) {
+        if (taken->what == "the point of" && AsciiLowercase(taken->name) == AsciiLowercase(part.designator)) {
+          diags_.Report(DiagKind::ImportDuplicateDesignator, part.designator_range, Printable(part.designator),
+                        taken->line, name);
+        } else {
+          diags_.Report(DiagKind::ImportNameCollision, part.designator_range, Printable(part.designator), wanted,
+                        fmt::format("that is {}", taken->Describe()), name);
+        }
+      }
+      point_name[b][i] = name;
+      double x = mirror == ImportMirror::kX ? -part.x_mm : part.x_mm;
+      double y = mirror == ImportMirror::kY ? -part.y_mm : part.y_mm;
+      double theta = part.rotation_deg;
+      if (mirror_rotation) theta = mirror == ImportMirror::kX ? 180.0 - theta : -theta;
+      double u = NormaliseAngle(theta + part.feeder->rotation_offset_deg, options_.angles);
+      ir::PointDecl point{name, loc, false,
+                          MakeCoords(loc, {x == 0 ? 0.0 : x, y == 0 ? 0.0 : y, options_.place_z_mm, u}), boards[b], loc};
+      items.push_back(MakeStmt(loc, std::move(point), comments[i]));
+    }
+  }
+
+  // --- Main: one Cycle, Pick/Place pairs grouped by feeder -----------------
+  ir::Cycle cycle;
+  cycle.fixture = options_.fixture;
+  cycle.fixture_loc = start;
+  cycle.end.loc = start;
+  std::vector<int> pockets_used(feeders.size(), 0);
+  for (std::size_t f = 0; f < feeders.size(); ++f) {
+    if (by_feeder[f].empty()) continue;
+    const cad::FeederSpec& feeder = feeders[f];
+    std::size_t count = by_feeder[f].size() * boards.size();
+    cycle.body.push_back(CommentStmt(start,
+                                     fmt::format("feeder {}: {} placement{}", feeder.name, count, count == 1 ? "" : "s"),
+                                     !cycle.body.empty()));
+    for (std::size_t b = 0; b < boards.size(); ++b) {
+      for (std::size_t i : by_feeder[f]) {
+        const Part* part = parts[i];
+        const SourceLoc loc = part->designator_range.begin;
+        ir::PickPlace pick;
+        std::string pick_comment;
+        pick.kind = ir::PickPlaceKind::Pick;
+        pick.target.loc = loc;
+        if (!feeder.is_pallet()) {
+          pick.target.base = ir::NamedPoint{pick_name[f], static_cast<std::uint32_t>(pick_name[f].size())};
+        } else {
+          int k = part->feeder->lane.value_or(0);
+          if (k == 0) {
+            k = ++pockets_used[f];
+            if (k == feeder.pick_points() + 1) {
+              diags_.Report(DiagKind::ImportPalletFeederFull, part->designator_range, Printable(feeder.name),
+                            feeder.pick_points(), feeder.pick_points() == 1 ? "point" : "points", feeder.columns,
+                            feeder.rows, k);
+            }
+          }
+          pick.target.base = ir::PalletPoint{IntLit(loc, std::max(pallet_number[f], 0)), IntLit(loc, k), nullptr};
+          pick_comment = part->feeder->lane ? fmt::format(" lane {}", k)
+                                            : fmt::format(" pocket {} of {}", k, feeder.pick_points());
+        }
+        cycle.body.push_back(MakeStmt(loc, std::move(pick), pick_comment));
+        ir::PickPlace place;
+        place.kind = ir::PickPlaceKind::Place;
+        place.target.loc = loc;
+        place.target.base = ir::NamedPoint{point_name[b][i], static_cast<std::uint32_t>(point_name[b][i].size())};
+        cycle.body.push_back(MakeStmt(loc, std::move(place), comments[i]));
+      }
+    }
+  }
+  ir::Function main;
+  main.name = "Main";
+  main.name_loc = start;
+  main.end.loc = start;
+  main.body.push_back(MakeStmt(start, std::move(cycle)));
+  items.push_back(MakeStmt(start, std::move(main)));
+  items.back()->blank_line_before = true;
+  if (diags_.has_errors()) return std::nullopt;
+  return program;
+}
+
+}  // namespace smtcal

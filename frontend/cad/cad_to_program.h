@@ -1,0 +1,151 @@
+// From CAD rows to a .place program (`smtcal import`, docs/import.md).
+//
+// The importer takes rows one at a time (Add), decides for each whether it is
+// placed or skipped (other side, DNP, excluded, no feeder with
+// --skip-unmapped; each skip is a warning at the row), and Finish builds the
+// program:
+//   Program, Units mm, Fixture <fixture>, Vacuum <n>
+//   a Local per board of the panel, In the fixture
+//   the feeders' pick points (robot base), as Points or Pallets
+//   one Point per part and board, In its board's Local
+//   Function Main with Cycle <fixture>: a Pick/Place pair per part, grouped
+//   by feeder (in the feeders' order), designator, value and package in a
+//   trailing comment.
+// Every generated statement borrows the location of what caused it (the
+// part's row, the feeder's table, the list's first line), so the IR passes
+// the verifier and a later diagnostic points into the list.
+//
+// Geometry (all in the fixture frame, mm and degrees): a part at (x, y, θ)
+// of the list is placed at (±x, ±y, place_z, u) in its board's Local, where
+// the mirror flips the coordinate across the board's axis for the side that
+// is turned over, and u is θ mapped by the mirror (180° - θ across x, -θ
+// across y, unless the list already gives bottom rotations as seen from
+// below), plus the feeder's rotation offset, normalised. Board (c, r) of
+// the panel sits at origin + R(rotation) · ((c-1)·pitch_x, (r-1)·pitch_y).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "frontend/cad/cad_reader.h"
+#include "frontend/cad/cad_row.h"
+#include "frontend/feeders_toml.h"
+#include "ir/ir.h"
+
+namespace smtcal {
+
+// Which board coordinate changes sign when the board is turned over to
+// place its bottom side: x (turned about its y axis, the default), y, or none
+// (the list already gives bottom-side positions as seen from below).
+enum class ImportMirror { kNone, kX, kY };
+// How the list writes the rotation of bottom-side parts.
+enum class BottomRotation { kTopView, kBottomView };
+// Rotations of the program: (-180, 180] or [0, 360).
+enum class AngleRange { kSigned, kPositive };
+
+struct ImportOptions {
+  std::optional<cad::Side> side;  // nullopt: the only side the list has parts on
+  std::optional<ImportMirror> mirror;  // nullopt: none for top, x for bottom
+  BottomRotation bottom_rotation = BottomRotation::kTopView;
+  AngleRange angles = AngleRange::kSigned;
+  double origin_x_mm = 0;  // the board origin in the fixture frame
+  double origin_y_mm = 0;
+  double rotation_deg = 0;  // the board's x axis against the fixture's
+  int columns = 1;          // panel
+  int rows = 1;
+  double pitch_x_mm = 0;
+  double pitch_y_mm = 0;
+  double place_z_mm = 0;  // z of the placements in the board frame
+  int vacuum = 8;         // the program's Vacuum output
+  bool skip_unmapped = false;
+  bool keep_dnp = false;
+  bool default_excludes = true;  // FID*, *Fiducial*, *MountingHole* (docs/import.md)
+  std::vector<std::string> exclude_designators;  // globs
+  std::vector<std::string> exclude_packages;
+  std::string program_name;  // a valid name; the Program line
+  std::string fixture;       // the cell fixture the board is on
+  std::vector<std::string> header_lines;  // comment lines opening the program (what was imported, how)
+};
+
+// Why rows were not placed.
+enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kCount };
+std::string_view SkipReasonName(SkipReason reason);
+
+struct ImportSummary {
+  std::size_t rows_read = 0;
+  std::size_t rows_with_errors = 0;
+  std::size_t parts_placed = 0;  // rows placed (on each board of the panel)
+  std::size_t boards = 1;
+  std::size_t feeders_used = 0;
+  std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
+  std::string format;  // "KiCad CSV, mm"
+  bool failed = false;  // errors stopped the import: nothing is placed
+};
+// "import: 12 rows read: 9 placed (x 4 boards = 36 placements, 3 feeders),
+// 3 skipped (2 other side, 1 DNP)" and the like, one line each.
+std::string FormatImportSummary(const ImportSummary& summary);
+
+class CadImporter {
+ public:
+  // `list_file` is the list's SourceManager id (locations of generated
+  // statements); `feeders` must outlive the importer.
+  CadImporter(const cad::FeederTable& feeders, ImportOptions options, std::uint32_t list_file, Diagnostics& diags);
+
+  // One row of the list: kept as a placement, or reported as skipped.
+  void Add(const cad::Row& row);
+  // The program, or nullopt when anything was an error (unmapped parts,
+  // mixed sides without --side, a full pallet, nothing to place). `reader`
+  // gives the row counts for the summary.
+  std::optional<ir::Program> Finish(const cad::ListReader& reader);
+
+  const ImportSummary& summary() const { return summary_; }
+
+ private:
+  struct Part {
+    std::uint32_t line = 0;
+    std::string designator;
+    std::string value;
+    std::string package;
+    double x_mm = 0;
+    double y_mm = 0;
+    double rotation_deg = 0;
+    cad::Side side = cad::Side::kTop;
+    std::optional<cad::FeederMatch> feeder;  // nullopt: no feeder holds it
+    // A skip that does not depend on the side (DNP, excluded), with what the
+    // warning says about it.
+    std::optional<SkipReason> skip;
+    int skip_detail = -1;  // index into skip_details_
+    SourceRange designator_range;
+    SourceRange side_range;
+    SourceRange skip_range;
+  };
+
+  bool Classify(const cad::Row& row, Part& part);
+  std::optional<cad::FeederMatch> FindFeeder(const cad::Row& row);
+  void ReportSkip(const Part& part, cad::Side placed_side);
+  void ReportUnmapped(const std::vector<const Part*>& unmapped);
+  std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side);
+
+  const cad::FeederTable& feeders_;
+  ImportOptions options_;
+  std::uint32_t list_file_;
+  Diagnostics& diags_;
+  std::vector<Part> parts_;  // every row read cleanly, in list order
+  // Feeder lookups by package and value, when no [[map]] looks at designators.
+  std::unordered_map<std::string, std::optional<cad::FeederMatch>> feeder_cache_;
+  std::string cache_key_;
+  std::vector<std::array<std::string, 4>> skip_details_;  // what the skip warnings say
+  ImportSummary summary_;
+};
+
+// A name for the .place language from any text: letters, digits and '_'
+// kept, everything else '_', a leading digit prefixed with '_', a keyword
+// followed by '_'. Never empty.
+std::string MakeIdentifier(std::string_view text);
+
+}  // namespace smtcal

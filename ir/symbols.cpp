@@ -1,0 +1,205 @@
+#include "ir/symbols.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace smtcal::sema {
+namespace {
+
+char LowerChar(char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); }
+
+}  // namespace
+
+std::string DescribeKind(const Symbol& symbol) {
+  switch (symbol.kind) {
+    case SymbolKind::Fixture: return "a fixture";
+    case SymbolKind::Local: return "a Local frame";
+    case SymbolKind::Point: {
+      const auto* point = symbol.decl ? std::get_if<ir::PointDecl>(&symbol.decl->node) : nullptr;
+      return point != nullptr && point->taught ? "a taught point" : "a point";
+    }
+    case SymbolKind::Variable: {
+      std::string type = symbol.var_type == ir::VarType::Integer ? "an Integer" : "a Real";
+      return type + (symbol.global ? " variable" : " local variable");
+    }
+    case SymbolKind::Function: return "a function";
+  }
+  return "a name";
+}
+
+std::string Lowercase(std::string_view name) {
+  std::string lower(name);
+  for (char& c : lower) c = LowerChar(c);
+  return lower;
+}
+
+bool SameName(std::string_view a, std::string_view b) {
+  return a.size() == b.size() &&
+         std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return LowerChar(x) == LowerChar(y); });
+}
+
+SourceRange NameAt(SourceLoc loc, std::string_view name) {
+  return SourceRange(loc, static_cast<std::uint32_t>(name.size()));
+}
+
+SourceRange StmtRange(const ir::Stmt& stmt) { return SourceRange(stmt.loc, stmt.length); }
+SourceRange ExprRange(const ir::Expr& expr) { return SourceRange(expr.loc, expr.length); }
+
+std::vector<Symbol> VariablesDeclaredBy(const ir::Stmt& stmt, bool global) {
+  std::vector<Symbol> result;
+  const auto* decl = std::get_if<ir::VarDecl>(&stmt.node);
+  if (decl == nullptr) return result;
+  for (std::size_t i = 0; i < decl->names.size(); ++i) {
+    Symbol symbol;
+    symbol.kind = SymbolKind::Variable;
+    symbol.name = decl->names[i];
+    SourceLoc loc = i < decl->name_locs.size() ? decl->name_locs[i] : stmt.loc;
+    symbol.range = NameAt(loc, decl->names[i]);
+    symbol.decl = &stmt;
+    symbol.var_type = decl->type;
+    symbol.global = global;
+    result.push_back(std::move(symbol));
+  }
+  return result;
+}
+
+// ------------------------------------------------------------------ SymbolTable
+
+SymbolTable SymbolTable::Build(const ir::Program& program) {
+  SymbolTable table;
+  auto named = [&](SymbolKind kind, const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
+    Symbol symbol;
+    symbol.kind = kind;
+    symbol.name = name;
+    symbol.range = NameAt(name_loc, name);
+    symbol.decl = &stmt;
+    table.Add(std::move(symbol));
+  };
+  for (const ir::StmtPtr& item : program.items) {
+    if (item == nullptr) continue;
+    const ir::Stmt& stmt = *item;
+    if (const auto* fixture = std::get_if<ir::FixtureDecl>(&stmt.node)) {
+      named(SymbolKind::Fixture, stmt, fixture->name, fixture->name_loc);
+    } else if (const auto* local = std::get_if<ir::LocalDecl>(&stmt.node)) {
+      named(SymbolKind::Local, stmt, local->name, local->name_loc);
+    } else if (const auto* point = std::get_if<ir::PointDecl>(&stmt.node)) {
+      named(SymbolKind::Point, stmt, point->name, point->name_loc);
+    } else if (const auto* function = std::get_if<ir::Function>(&stmt.node)) {
+      named(SymbolKind::Function, stmt, function->name, function->name_loc);
+    } else if (std::holds_alternative<ir::VarDecl>(stmt.node)) {
+      for (Symbol& variable : VariablesDeclaredBy(stmt, /*global=*/true)) table.Add(std::move(variable));
+    } else if (const auto* pallet = std::get_if<ir::PalletDecl>(&stmt.node)) {
+      PalletEntry entry{&stmt, pallet};
+      auto [it, inserted] = table.pallets_.emplace(pallet->number, entry);
+      if (!inserted) table.duplicate_pallets_.emplace_back(it->second, entry);
+    }
+  }
+  return table;
+}
+
+void SymbolTable::Add(Symbol symbol) {
+  std::string key = Lowercase(symbol.name);
+  auto it = by_name_.find(key);
+  if (it != by_name_.end()) {
+    duplicates_.push_back({*it->second, std::move(symbol)});
+    return;
+  }
+  symbols_.push_back(std::move(symbol));
+  by_name_.emplace(std::move(key), &symbols_.back());
+}
+
+const Symbol* SymbolTable::Find(std::string_view name) const {
+  auto it = by_name_.find(Lowercase(name));
+  return it == by_name_.end() ? nullptr : it->second;
+}
+
+std::vector<std::string> SymbolTable::NamesOf(std::initializer_list<SymbolKind> kinds) const {
+  std::vector<std::string> names;
+  for (const Symbol& symbol : symbols_) {
+    if (std::find(kinds.begin(), kinds.end(), symbol.kind) != kinds.end()) names.push_back(symbol.name);
+  }
+  return names;
+}
+
+const SymbolTable::PalletEntry* SymbolTable::FindPallet(int number) const {
+  auto it = pallets_.find(number);
+  return it == pallets_.end() ? nullptr : &it->second;
+}
+
+std::vector<int> SymbolTable::PalletNumbers() const {
+  std::vector<int> numbers;
+  for (const auto& [number, entry] : pallets_) numbers.push_back(number);
+  return numbers;
+}
+
+const Symbol* SymbolTable::FixtureOfFrame(const Symbol& frame) const {
+  const Symbol* current = &frame;
+  // A chain longer than the number of symbols must revisit one: a loop.
+  for (std::size_t steps = 0; steps <= symbols_.size(); ++steps) {
+    if (current->kind == SymbolKind::Fixture) return current;
+    if (current->kind != SymbolKind::Local || current->decl == nullptr) return nullptr;
+    const auto& local = std::get<ir::LocalDecl>(current->decl->node);
+    if (local.frame.empty()) return nullptr;
+    current = Find(local.frame);
+    if (current == nullptr) return nullptr;
+  }
+  return nullptr;
+}
+
+const Symbol* SymbolTable::FixtureOfPoint(const Symbol& point) const {
+  if (point.kind != SymbolKind::Point || point.decl == nullptr) return nullptr;
+  const auto& decl = std::get<ir::PointDecl>(point.decl->node);
+  if (decl.frame.empty()) return nullptr;
+  const Symbol* frame = Find(decl.frame);
+  return frame == nullptr ? nullptr : FixtureOfFrame(*frame);
+}
+
+PointFrame SymbolTable::FrameOfPoint(const Symbol& point) {
+  const auto& decl = std::get<ir::PointDecl>(point.decl->node);
+  return PointFrame{decl.taught, Lowercase(decl.frame)};
+}
+
+const Symbol* SymbolTable::FixtureOfPallet(int number) const {
+  const PalletEntry* entry = FindPallet(number);
+  if (entry == nullptr) return nullptr;
+  const Symbol* first = nullptr;
+  for (const std::string& corner : entry->pallet->corners) {
+    const Symbol* point = Find(corner);
+    if (point == nullptr || point->kind != SymbolKind::Point) return nullptr;
+    if (first == nullptr) {
+      first = point;
+    } else if (!(FrameOfPoint(*point) == FrameOfPoint(*first))) {
+      return nullptr;
+    }
+  }
+  return first == nullptr ? nullptr : FixtureOfPoint(*first);
+}
+
+// ------------------------------------------------------------------ LocalScope
+
+const Symbol* LocalScope::Declare(Symbol local) {
+  std::string key = Lowercase(local.name);
+  auto it = by_name_.find(key);
+  if (it != by_name_.end()) return it->second;
+  const Symbol* global = globals_.Find(local.name);
+  locals_.push_back(std::move(local));
+  by_name_.emplace(std::move(key), &locals_.back());
+  return global;
+}
+
+const Symbol* LocalScope::Find(std::string_view name) const {
+  auto it = by_name_.find(Lowercase(name));
+  if (it != by_name_.end()) return it->second;
+  return globals_.Find(name);
+}
+
+std::vector<std::string> LocalScope::VariableNames() const {
+  std::vector<std::string> names;
+  for (const Symbol& local : locals_) names.push_back(local.name);
+  for (std::string& global : globals_.NamesOf({SymbolKind::Variable})) {
+    if (by_name_.count(Lowercase(global)) == 0) names.push_back(std::move(global));
+  }
+  return names;
+}
+
+}  // namespace smtcal::sema

@@ -1,0 +1,135 @@
+// The symbol table the semantic checks share. A .place program has one
+// namespace for fixtures, Local frames, points, global variables and
+// functions; like SPEL+, names are case-insensitive. Top-level declarations
+// are order-independent. Pallets are named by number and kept apart.
+//
+// Building the table never reports anything: the first definition of a name
+// wins and later ones are recorded as duplicates, so every check can build
+// its own table cheaply and only check_names reports the duplicates.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <initializer_list>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "base/source.h"
+#include "ir/ir.h"
+
+namespace smtcal::sema {
+
+enum class SymbolKind { Fixture, Local, Point, Variable, Function };
+
+struct Symbol {
+  SymbolKind kind = SymbolKind::Point;
+  std::string name;              // as declared
+  SourceRange range;             // the name in its declaration
+  const ir::Stmt* decl = nullptr;  // the declaring statement
+  ir::VarType var_type = ir::VarType::Integer;  // Variable only
+  bool global = true;                           // Variable only: false for a function's local
+};
+
+// What a name is, with its article, for messages: "a point", "a taught point",
+// "a fixture", "a Local frame", "an Integer variable", "a function".
+std::string DescribeKind(const Symbol& symbol);
+// Case-insensitive key of a name.
+std::string Lowercase(std::string_view name);
+bool SameName(std::string_view a, std::string_view b);
+
+// The range of `name` written at `loc` (names are kept as written, so the
+// caret underlines exactly the name).
+SourceRange NameAt(SourceLoc loc, std::string_view name);
+// The range of a statement's first token.
+SourceRange StmtRange(const ir::Stmt& stmt);
+SourceRange ExprRange(const ir::Expr& expr);
+
+// Where a point's coordinates are given. Two points are in the same frame
+// exactly when their frames compare equal.
+struct PointFrame {
+  bool taught = false;
+  std::string frame;  // lowercase; empty = robot base
+  friend bool operator==(const PointFrame&, const PointFrame&) = default;
+};
+
+class SymbolTable {
+ public:
+  struct Duplicate {
+    Symbol first;
+    Symbol again;
+  };
+  struct PalletEntry {
+    const ir::Stmt* stmt = nullptr;
+    const ir::PalletDecl* pallet = nullptr;
+  };
+
+  // Collects the top-level declarations of `program` (not function locals).
+  static SymbolTable Build(const ir::Program& program);
+
+  const Symbol* Find(std::string_view name) const;
+  // First definitions, in source order.
+  const std::deque<Symbol>& symbols() const { return symbols_; }
+  const std::vector<Duplicate>& duplicates() const { return duplicates_; }
+  // Declared names of the given kinds, for "did you mean" suggestions.
+  std::vector<std::string> NamesOf(std::initializer_list<SymbolKind> kinds) const;
+
+  const PalletEntry* FindPallet(int number) const;
+  // The second and later declarations of a pallet number, with the first.
+  const std::vector<std::pair<PalletEntry, PalletEntry>>& duplicate_pallets() const {
+    return duplicate_pallets_;
+  }
+  std::vector<int> PalletNumbers() const;
+
+  // The fixture a frame (Fixture or Local) ultimately hangs in, following the
+  // chain of Local frames `In` each other; null when the chain ends in the
+  // robot base, at an undefined or wrong-kind name, or loops.
+  const Symbol* FixtureOfFrame(const Symbol& frame) const;
+  // The fixture a point belongs to: `In` a fixture-rooted frame, or `Taught
+  // ... On FIXTURE`; null for robot-base points.
+  const Symbol* FixtureOfPoint(const Symbol& point) const;
+  // The frame a point's coordinates are given in.
+  static PointFrame FrameOfPoint(const Symbol& point);
+  // The fixture of a pallet: the fixture of its corners when all three are
+  // defined points in one frame; null otherwise.
+  const Symbol* FixtureOfPallet(int number) const;
+
+ private:
+  void Add(Symbol symbol);
+
+  std::deque<Symbol> symbols_;  // deque: Find's pointers stay valid
+  std::map<std::string, const Symbol*> by_name_;
+  std::vector<Duplicate> duplicates_;
+  std::map<int, PalletEntry> pallets_;
+  std::vector<std::pair<PalletEntry, PalletEntry>> duplicate_pallets_;
+};
+
+// A function's local variables, declared as a check walks the body in source
+// order (SPEL+: a local is visible from its declaration to Fend, whatever
+// block it is declared in). Lookups fall back to the global table.
+class LocalScope {
+ public:
+  explicit LocalScope(const SymbolTable& globals) : globals_(globals) {}
+
+  // Declares a local; returns the symbol it collides with, else null. A
+  // local that collides with an earlier local is not declared again; one
+  // that collides with a global is declared and hides it, so that the uses
+  // after it (which mean the local) are not reported a second time.
+  const Symbol* Declare(Symbol local);
+  // Locals first, then globals.
+  const Symbol* Find(std::string_view name) const;
+  // Every variable visible here (locals and globals), for suggestions.
+  std::vector<std::string> VariableNames() const;
+
+ private:
+  const SymbolTable& globals_;
+  std::deque<Symbol> locals_;
+  std::map<std::string, const Symbol*> by_name_;
+};
+
+// The symbols a VarDecl statement declares (one per name).
+std::vector<Symbol> VariablesDeclaredBy(const ir::Stmt& stmt, bool global);
+
+}  // namespace smtcal::sema

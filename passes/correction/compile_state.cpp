@@ -1,0 +1,76 @@
+// Helpers of the compile state (passes/correction/compile_state.h).
+#include "passes/correction/compile_state.h"
+
+#include <cmath>
+
+#include "ir/symbols.h"
+
+namespace smtcal {
+
+std::string_view CorrectionKindName(CorrectionKind kind) {
+  switch (kind) {
+    case CorrectionKind::kStatic: return "static";
+    case CorrectionKind::kRunTimeBase: return "run-time";
+    case CorrectionKind::kFixture: return "fixture";
+    case CorrectionKind::kUncorrected: return "uncorrected";
+  }
+  return "?";
+}
+
+bool Target::is_placement() const {
+  const auto* pick = std::get_if<ir::PickPlace>(&stmt->node);
+  return pick != nullptr && pick->kind == ir::PickPlaceKind::Place;
+}
+
+int CompileState::FindFixture(std::string_view name) const {
+  if (name.empty()) return -1;
+  for (std::size_t i = 0; i < fixtures.size(); ++i) {
+    if (sema::SameName(fixtures[i].name, name)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+const InverseSolver& CompileState::SolverFor(const cell::Region& region) {
+  std::unique_ptr<InverseSolver>& solver = solvers_[&region];
+  if (!solver) solver = std::make_unique<InverseSolver>(region.table);
+  return *solver;
+}
+
+Pose4 PoseToBase(const Eigen::Affine3d& fix, const Pose4& in_fixture) {
+  Eigen::Vector3d p = fix * Eigen::Vector3d(in_fixture[0], in_fixture[1], in_fixture[2]);
+  return {p.x(), p.y(), p.z(), in_fixture[3] + PoseValues(fix)[3]};
+}
+
+Pose4 PoseToFixture(const Eigen::Affine3d& fix, const Pose4& in_base) {
+  Eigen::Vector3d p = fix.inverse() * Eigen::Vector3d(in_base[0], in_base[1], in_base[2]);
+  return {p.x(), p.y(), p.z(), in_base[3] - PoseValues(fix)[3]};
+}
+
+TeachPose EstimateTeachPose(const cell::Fixture& fixture, const cell::Cell& cell) {
+  ScanResult scan = TeachScan(cell, fixture);
+  if (scan.fix) return {*scan.fix, ""};
+  return {std::nullopt, DescribeFailure(scan, fixture)};
+}
+
+double CompileState::SensorShareAt(const cell::Fixture& fixture, const Eigen::Vector2d& point_in_fixture) {
+  std::unique_ptr<SensorShare>& share = sensor_shares_[&fixture];
+  if (!share) share = std::make_unique<SensorShare>(fixture);
+  return share->AtMm(point_in_fixture);
+}
+
+std::string_view TargetKeyword(const ir::Stmt& stmt) {
+  if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
+    return pick->kind == ir::PickPlaceKind::Pick ? "Pick" : "Place";
+  }
+  switch (std::get<ir::Motion>(stmt.node).kind) {
+    case ir::MotionKind::Jump: return "Jump";
+    case ir::MotionKind::Go: return "Go";
+    case ir::MotionKind::Move: return "Move";
+  }
+  return "?";
+}
+
+double RoundForProgramText(double value) { return std::round(value * 1e10) / 1e10; }
+
+}  // namespace smtcal
+

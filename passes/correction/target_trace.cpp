@@ -1,0 +1,453 @@
+// Running a program at compile time to find its motion targets
+// (passes/correction/target_trace.h).
+#include "passes/correction/target_trace.h"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "base/check.h"
+#include "ir/ir_ops.h"
+#include "ir/ir_text.h"
+#include "ir/ir_walk.h"
+
+namespace smtcal {
+namespace {
+
+using Value = std::optional<double>;  // nullopt: known only at run time
+using Variables = std::map<std::string, Value>;
+
+// What a target's position depends on that is not known before run time.
+struct Unknown {
+  std::string because;
+};
+
+class Tracer {
+ public:
+  Tracer(const sema::SymbolTable& symbols, CompileState& state) : symbols_(symbols), state_(state) {}
+
+  void Run() {
+    for (const sema::Symbol& symbol : symbols_.symbols()) {
+      if (symbol.kind == sema::SymbolKind::Variable) globals_[sema::Lowercase(symbol.name)] = 0.0;
+    }
+    const sema::Symbol* main = symbols_.Find("Main");
+    if (main == nullptr || main->kind != sema::SymbolKind::Function) return;
+    Frame frame{&std::get<ir::Function>(main->decl->node), {}, "Main"};
+    RunBlock(frame.function->body, frame);
+    state_.trace_complete = !out_of_steps_;
+  }
+
+ private:
+  struct Frame {
+    const ir::Function* function;
+    Variables locals;
+    std::string call_path;
+  };
+  enum class Flow { kNext, kExitFunction, kStop };
+
+  // ---------------------------------------------------------------- values
+
+  Value* Lookup(const std::string& name, Frame& frame) {
+    std::string key = sema::Lowercase(name);
+    if (auto it = frame.locals.find(key); it != frame.locals.end()) return &it->second;
+    if (auto it = globals_.find(key); it != globals_.end()) return &it->second;
+    return nullptr;
+  }
+
+  Value Eval(const ir::Expr* expr, Frame& frame) {
+    if (expr == nullptr) return std::nullopt;
+    return std::visit(
+        [&](const auto& node) -> Value {
+          using Node = std::decay_t<decltype(node)>;
+          if constexpr (std::is_same_v<Node, ir::NumberLit>) {
+            return node.value;
+          } else if constexpr (std::is_same_v<Node, ir::VariableRef>) {
+            Value* value = Lookup(node.name, frame);
+            return value == nullptr ? std::nullopt : *value;
+          } else if constexpr (std::is_same_v<Node, ir::OnOffLit>) {
+            return node.on ? 1.0 : 0.0;
+          } else if constexpr (std::is_same_v<Node, ir::SwitchRead>) {
+            return std::nullopt;  // an input: known only at run time
+          } else if constexpr (std::is_same_v<Node, ir::UnaryExpr>) {
+            Value operand = Eval(node.operand.get(), frame);
+            if (!operand) return std::nullopt;
+            switch (node.op) {
+              case ir::UnaryOp::Negate: return -*operand;
+              case ir::UnaryOp::Plus: return *operand;
+              case ir::UnaryOp::Not: return *operand == 0 ? 1.0 : 0.0;
+            }
+            return std::nullopt;
+          } else {
+            return Binary(node, frame);
+          }
+        },
+        expr->node);
+  }
+
+  Value Binary(const ir::BinaryExpr& node, Frame& frame) {
+    Value lhs = Eval(node.lhs.get(), frame);
+    Value rhs = Eval(node.rhs.get(), frame);
+    // And/Or decide on one known side alone.
+    if (node.op == ir::BinaryOp::And && ((lhs && *lhs == 0) || (rhs && *rhs == 0))) return 0.0;
+    if (node.op == ir::BinaryOp::Or && ((lhs && *lhs != 0) || (rhs && *rhs != 0))) return 1.0;
+    if (!lhs || !rhs) return std::nullopt;
+    double a = *lhs, b = *rhs;
+    auto truth = [](bool v) { return v ? 1.0 : 0.0; };
+    switch (node.op) {
+      case ir::BinaryOp::Add: return a + b;
+      case ir::BinaryOp::Sub: return a - b;
+      case ir::BinaryOp::Mul: return a * b;
+      case ir::BinaryOp::Div: return b == 0 ? std::nullopt : Value(a / b);
+      case ir::BinaryOp::Mod: return b == 0 ? std::nullopt : Value(std::fmod(a, b));
+      case ir::BinaryOp::Eq: return truth(a == b);
+      case ir::BinaryOp::Ne: return truth(a != b);
+      case ir::BinaryOp::Lt: return truth(a < b);
+      case ir::BinaryOp::Gt: return truth(a > b);
+      case ir::BinaryOp::Le: return truth(a <= b);
+      case ir::BinaryOp::Ge: return truth(a >= b);
+      case ir::BinaryOp::And: return truth(a != 0 && b != 0);
+      case ir::BinaryOp::Or: return truth(a != 0 || b != 0);
+      case ir::BinaryOp::Xor: return truth((a != 0) != (b != 0));
+    }
+    return std::nullopt;
+  }
+
+  // The first run-time value `expr` reads, for messages.
+  std::string FirstUnknown(const ir::Expr* expr, Frame& frame) {
+    std::string found;
+    ir::ForEachExpr(expr, [&](const ir::Expr& e) {
+      if (!found.empty()) return;
+      if (const auto* var = std::get_if<ir::VariableRef>(&e.node)) {
+        Value* value = Lookup(var->name, frame);
+        if (value == nullptr || !*value) found = var->name;
+      } else if (std::holds_alternative<ir::SwitchRead>(e.node)) {
+        found = PrintExpr(e);
+      }
+    });
+    return found.empty() ? PrintExpr(*expr) : found;
+  }
+
+  // ---------------------------------------------------------------- points
+
+  std::variant<RootedPose, Unknown> PointPosition(const ir::PointExpr& target, Frame& frame,
+                                                  const ir::Stmt*& taught_decl) {
+    RootedPose rooted;
+    std::string frame_name;
+    Pose4 local{};
+    if (const auto* named = std::get_if<ir::NamedPoint>(&target.base)) {
+      const sema::Symbol* point = symbols_.Find(named->name);
+      SMTCAL_CHECK(point != nullptr && point->kind == sema::SymbolKind::Point,
+                   "a checked program names only points as targets");
+      const auto& decl = std::get<ir::PointDecl>(point->decl->node);
+      local = decl.coords.values;
+      frame_name = decl.frame;
+      if (decl.taught) taught_decl = point->decl;
+    } else if (const auto* coords = std::get_if<ir::Coords>(&target.base)) {
+      local = coords->values;
+    } else {
+      const auto& pallet = std::get<ir::PalletPoint>(target.base);
+      std::variant<Pose4, Unknown> slot = PalletSlot(pallet, frame, frame_name, taught_decl);
+      if (auto* unknown = std::get_if<Unknown>(&slot)) return *unknown;
+      local = std::get<Pose4>(slot);
+    }
+    for (const ir::PointOffset& offset : target.offsets) {
+      Value amount = Eval(offset.amount.get(), frame);
+      if (!amount) return Unknown{FirstUnknown(offset.amount.get(), frame)};
+      local[ir::AxisIndex(offset.axis)] += offset.negative ? -*amount : *amount;
+    }
+    if (taught_decl != nullptr) {
+      // Taught coordinates are robot coordinates; the frame is the fixture.
+      const auto& decl = std::get<ir::PointDecl>(taught_decl->node);
+      return RootedPose{decl.frame, local};
+    }
+    return ResolveFrame(symbols_, frame_name, local);
+  }
+
+  // Pallet(n, i, j): P1 + (i-1)/(columns-1) (P2-P1) + (j-1)/(rows-1) (P3-P1),
+  // in the corners' frame (checks made sure they share one).
+  std::variant<Pose4, Unknown> PalletSlot(const ir::PalletPoint& pallet, Frame& frame, std::string& frame_name,
+                                          const ir::Stmt*& taught_decl) {
+    Value number = Eval(pallet.number.get(), frame);
+    if (!number) return Unknown{FirstUnknown(pallet.number.get(), frame)};
+    const sema::SymbolTable::PalletEntry* entry = symbols_.FindPallet(static_cast<int>(*number));
+    SMTCAL_CHECK(entry != nullptr, "a checked program uses only declared pallets");
+    const ir::PalletDecl& decl = *entry->pallet;
+    Value i = Eval(pallet.i.get(), frame);
+    if (!i) return Unknown{FirstUnknown(pallet.i.get(), frame)};
+    double column = *i, row = 1;
+    if (pallet.j) {
+      Value j = Eval(pallet.j.get(), frame);
+      if (!j) return Unknown{FirstUnknown(pallet.j.get(), frame)};
+      row = *j;
+    } else {  // k counts along the first row, then the next
+      double k = *i - 1;
+      column = std::fmod(k, decl.columns) + 1;
+      row = std::floor(k / decl.columns) + 1;
+    }
+    std::array<Pose4, 3> corners;
+    for (int c = 0; c < 3; ++c) {
+      const sema::Symbol* point = symbols_.Find(decl.corners[c]);
+      SMTCAL_CHECK(point != nullptr && point->kind == sema::SymbolKind::Point, "checked pallet corners");
+      const auto& corner = std::get<ir::PointDecl>(point->decl->node);
+      corners[c] = corner.coords.values;
+      frame_name = corner.frame;
+      if (corner.taught) taught_decl = point->decl;
+    }
+    double s = decl.columns > 1 ? (column - 1) / (decl.columns - 1) : 0;
+    double t = decl.rows > 1 ? (row - 1) / (decl.rows - 1) : 0;
+    Pose4 slot{};
+    for (int a = 0; a < 4; ++a) {
+      slot[a] = corners[0][a] + s * (corners[1][a] - corners[0][a]) + t * (corners[2][a] - corners[0][a]);
+    }
+    return slot;
+  }
+
+  void RecordTarget(const ir::Stmt& stmt, const ir::PointExpr& point, Frame& frame) {
+    const ir::Stmt* taught_decl = nullptr;
+    std::variant<RootedPose, Unknown> position = PointPosition(point, frame, taught_decl);
+    Target target;
+    target.stmt = &stmt;
+    target.text = PrintPointExpr(point);
+    target.call_path = frame.call_path;
+    target.taught_decl = taught_decl;
+    if (auto* unknown = std::get_if<Unknown>(&position)) {
+      target.known = false;
+      target.unknown_because = unknown->because;
+      // The frame is still known: the point's declaration decides it.
+      target.fixture = state_.FindFixture(FrameRootOf(point, frame));
+    } else {
+      const RootedPose& rooted = std::get<RootedPose>(position);
+      target.fixture = rooted.fixture.empty() ? -1 : state_.FindFixture(rooted.fixture);
+      target.in_frame = rooted.pose;
+      if (taught_decl != nullptr) {
+        const auto& decl = std::get<ir::PointDecl>(taught_decl->node);
+        for (int a = 0; a < 4; ++a) target.taught_offset[a] = rooted.pose[a] - decl.coords.values[a];
+      }
+    }
+    // A fixture the cell does not describe is reported by bind; its targets
+    // have no frame to be corrected in.
+    if (target.fixture < 0 && FixtureNamed(point, frame)) return;
+    auto key = std::make_tuple(&stmt, target.known, target.in_frame);
+    auto [it, inserted] = seen_.emplace(key, state_.targets.size());
+    if (inserted) state_.targets.push_back(std::move(target));
+    if (trace_ != nullptr && !exploring_) trace_->push_back({TraceEvent::Kind::kMotion, it->second, 0});
+  }
+
+  // Whether the target hangs on a fixture (bound to the cell or not).
+  bool FixtureNamed(const ir::PointExpr& point, Frame& frame) { return !FrameRootOf(point, frame).empty(); }
+
+  // The root frame (fixture name or "") of a target whose position is unknown.
+  std::string FrameRootOf(const ir::PointExpr& point, Frame& frame) {
+    std::string frame_name;
+    if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
+      const sema::Symbol* symbol = symbols_.Find(named->name);
+      const auto& decl = std::get<ir::PointDecl>(symbol->decl->node);
+      if (decl.taught) return decl.frame;
+      frame_name = decl.frame;
+    } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
+      Value number = Eval(pallet->number.get(), frame);
+      if (!number) return "";
+      const sema::SymbolTable::PalletEntry* entry = symbols_.FindPallet(static_cast<int>(*number));
+      if (entry == nullptr) return "";
+      const auto& corner = std::get<ir::PointDecl>(symbols_.Find(entry->pallet->corners[0])->decl->node);
+      if (corner.taught) return corner.frame;
+      frame_name = corner.frame;
+    }
+    return ResolveFrame(symbols_, frame_name, Pose4{}).fixture;
+  }
+
+  // ---------------------------------------------------------------- statements
+
+  bool Step() {
+    if (++steps_ > kMaxTraceSteps) out_of_steps_ = true;
+    return !out_of_steps_;
+  }
+
+  Flow RunBlock(const ir::Block& block, Frame& frame) {
+    for (const ir::StmtPtr& stmt : block) {
+      if (!Step()) return Flow::kStop;
+      Flow flow = RunStmt(*stmt, frame);
+      if (flow != Flow::kNext) return flow;
+    }
+    return Flow::kNext;
+  }
+
+  Flow RunStmt(const ir::Stmt& stmt, Frame& frame) {
+    if (const auto* decl = std::get_if<ir::VarDecl>(&stmt.node)) {
+      for (const std::string& name : decl->names) frame.locals[sema::Lowercase(name)] = 0.0;
+    } else if (const auto* assign = std::get_if<ir::Assign>(&stmt.node)) {
+      Value value = Eval(assign->value.get(), frame);
+      if (Value* target = Lookup(assign->name, frame)) *target = value;
+    } else if (const auto* motion = std::get_if<ir::Motion>(&stmt.node)) {
+      RecordTarget(stmt, motion->target, frame);
+    } else if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
+      RecordTarget(stmt, pick->target, frame);
+    } else if (const auto* wait = std::get_if<ir::WaitTime>(&stmt.node)) {
+      Value seconds = Eval(wait->seconds.get(), frame);
+      if (trace_ != nullptr && !exploring_ && seconds) trace_->push_back({TraceEvent::Kind::kWait, 0, *seconds});
+    } else if (const auto* loop = std::get_if<ir::For>(&stmt.node)) {
+      return RunFor(*loop, frame);
+    } else if (const auto* branch = std::get_if<ir::If>(&stmt.node)) {
+      return RunIf(*branch, frame);
+    } else if (const auto* call = std::get_if<ir::Call>(&stmt.node)) {
+      const sema::Symbol* function = symbols_.Find(call->name);
+      if (function == nullptr || function->kind != sema::SymbolKind::Function) return Flow::kNext;
+      Frame callee{&std::get<ir::Function>(function->decl->node), {}, frame.call_path + " > " + function->name};
+      Flow flow = RunBlock(callee.function->body, callee);
+      return flow == Flow::kStop ? Flow::kStop : Flow::kNext;
+    } else if (const auto* cycle = std::get_if<ir::Cycle>(&stmt.node)) {
+      return RunCycle(stmt, *cycle, frame);
+    } else if (std::holds_alternative<ir::ExitFunction>(stmt.node)) {
+      return Flow::kExitFunction;
+    }
+    return Flow::kNext;
+  }
+
+  Flow RunCycle(const ir::Stmt& stmt, const ir::Cycle& cycle, Frame& frame) {
+    std::vector<TraceEvent>* outer = trace_;
+    bool first = !state_.cycle_traces.contains(&stmt) && !exploring_;
+    if (first) trace_ = &state_.cycle_traces[&stmt];
+    Flow flow = RunBlock(cycle.body, frame);
+    if (first) trace_ = outer;
+    return flow;
+  }
+
+  Flow RunFor(const ir::For& loop, Frame& frame) {
+    Value from = Eval(loop.from.get(), frame);
+    Value to = Eval(loop.to.get(), frame);
+    Value step = loop.step ? Eval(loop.step.get(), frame) : Value(1.0);
+    Value* var = Lookup(loop.var, frame);
+    if (var == nullptr) return Flow::kNext;
+    if (!from || !to || !step || *step == 0) {
+      *var = std::nullopt;
+      Variables before_globals = globals_, before_locals = frame.locals;
+      Flow flow = RunBlock(loop.body, frame);
+      // After an unknown number of runs, whatever the body changed is unknown.
+      ForgetChanged(before_globals, globals_);
+      ForgetChanged(before_locals, frame.locals);
+      return flow == Flow::kStop || flow == Flow::kExitFunction ? flow : Flow::kNext;
+    }
+    for (double v = *from; *step > 0 ? v <= *to : v >= *to; v += *step) {
+      *Lookup(loop.var, frame) = v;
+      Flow flow = RunBlock(loop.body, frame);
+      if (flow != Flow::kNext) return flow;
+      if (!Step()) return Flow::kStop;
+    }
+    return Flow::kNext;
+  }
+
+  static void ForgetChanged(const Variables& before, Variables& after) {
+    for (auto& [name, value] : after) {
+      auto it = before.find(name);
+      if (it == before.end() || it->second != value) value = std::nullopt;
+    }
+  }
+
+  Flow RunIf(const ir::If& branch, Frame& frame) {
+    std::vector<const ir::IfBranch*> candidates;
+    for (const ir::IfBranch& b : branch.branches) {
+      if (b.condition == nullptr) {  // Else
+        candidates.push_back(&b);
+        break;
+      }
+      Value condition = Eval(b.condition.get(), frame);
+      if (condition && *condition != 0) {
+        candidates.push_back(&b);
+        break;
+      }
+      if (!condition) candidates.push_back(&b);
+    }
+    bool has_else = !branch.branches.empty() && branch.branches.back().condition == nullptr;
+    bool decided = candidates.size() == 1 && (candidates[0]->condition == nullptr ||
+                                               Eval(candidates[0]->condition.get(), frame).has_value());
+    if (decided) return RunBlock(candidates[0]->body, frame);
+    if (candidates.empty()) return Flow::kNext;
+    // Several branches may run: each on a copy; the merge keeps what they agree on.
+    // The trace follows the branch taken when every unknown condition is false.
+    const ir::IfBranch* traced = nullptr;
+    for (const ir::IfBranch* b : candidates) {
+      Value condition = b->condition ? Eval(b->condition.get(), frame) : Value(1.0);
+      if (condition && *condition != 0) {
+        traced = b;
+        break;
+      }
+    }
+    Variables globals_in = globals_, locals_in = frame.locals;
+    std::vector<std::pair<Variables, Variables>> outcomes;
+    bool stopped = false;
+    for (const ir::IfBranch* b : candidates) {
+      globals_ = globals_in;
+      frame.locals = locals_in;
+      bool was_exploring = exploring_;
+      exploring_ = exploring_ || b != traced;
+      Flow flow = RunBlock(b->body, frame);
+      exploring_ = was_exploring;
+      if (flow == Flow::kStop) stopped = true;
+      outcomes.emplace_back(globals_, frame.locals);
+    }
+    if (!has_else) outcomes.emplace_back(globals_in, locals_in);  // no branch taken
+    globals_ = Merge(outcomes, true);
+    frame.locals = Merge(outcomes, false);
+    return stopped ? Flow::kStop : Flow::kNext;
+  }
+
+  static Variables Merge(const std::vector<std::pair<Variables, Variables>>& outcomes, bool globals) {
+    Variables merged = globals ? outcomes[0].first : outcomes[0].second;
+    for (const auto& outcome : outcomes) {
+      const Variables& vars = globals ? outcome.first : outcome.second;
+      for (auto& [name, value] : merged) {
+        auto it = vars.find(name);
+        if (it == vars.end() || it->second != value) value = std::nullopt;
+      }
+    }
+    return merged;
+  }
+
+  const sema::SymbolTable& symbols_;
+  CompileState& state_;
+  Variables globals_;
+  std::map<std::tuple<const ir::Stmt*, bool, Pose4>, std::size_t> seen_;
+  std::vector<TraceEvent>* trace_ = nullptr;
+  bool exploring_ = false;  // in a branch the cycle trace does not follow
+  long steps_ = 0;
+  bool out_of_steps_ = false;
+};
+
+}  // namespace
+
+RootedPose ResolveFrame(const sema::SymbolTable& symbols, const std::string& frame, const Pose4& local) {
+  RootedPose rooted{"", local};
+  std::string current = frame;
+  for (std::size_t hops = 0; !current.empty() && hops <= symbols.symbols().size(); ++hops) {
+    const sema::Symbol* symbol = symbols.Find(current);
+    SMTCAL_CHECK(symbol != nullptr, "a checked program's frames are declared");
+    if (symbol->kind == sema::SymbolKind::Fixture) {
+      rooted.fixture = symbol->name;
+      return rooted;
+    }
+    SMTCAL_CHECK(symbol->kind == sema::SymbolKind::Local, "a checked program's frames are fixtures or Locals");
+    const auto& decl = std::get<ir::LocalDecl>(symbol->decl->node);
+    const Pose4& origin = decl.origin.values;
+    double angle = Radians(origin[3]);
+    double c = std::cos(angle), s = std::sin(angle);
+    Pose4 parent = rooted.pose;
+    parent[0] = origin[0] + c * rooted.pose[0] - s * rooted.pose[1];
+    parent[1] = origin[1] + s * rooted.pose[0] + c * rooted.pose[1];
+    parent[2] = origin[2] + rooted.pose[2];
+    parent[3] = origin[3] + rooted.pose[3];
+    rooted.pose = parent;
+    current = decl.frame;
+  }
+  return rooted;
+}
+
+void TraceTargets(const ir::Program& /*program*/, const sema::SymbolTable& symbols, CompileState& state) {
+  Tracer(symbols, state).Run();
+}
+
+}  // namespace smtcal

@@ -1,0 +1,218 @@
+// verify: what the corrected program commands is within what the cell can do.
+//
+// Assumes: static-inversion and fixture-correction ran.
+// Guarantees when it reports no error, for every target whose position is
+// known: its command lies within the robot's axis limits; a fixture target
+// stays inside its region for every pose the fixture's check limits let a
+// cycle run with (any shift up to max_shift_mm, any rotation up to
+// max_rotation_deg about the fixture origin), so the runtime's inverse never
+// leaves its table; every inverse residual is within kInverseResidualTolMm;
+// every Pick and Place fits its region's tolerance with the budget residual +
+// repeatability + sensor share (fixture targets). It also estimates each
+// Cycle's time and the scan's share of it (state.cycles). Never changes the IR.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "ir/constant_fold.h"
+#include "ir/symbols.h"
+#include "passes/correction/compile_state.h"
+#include "passes/correction/correction_passes.h"
+
+namespace smtcal {
+
+namespace {
+
+// Time to move `distance` with a trapezoidal profile (triangular when short).
+double MoveTime(double distance, double speed, double accel) {
+  distance = std::abs(distance);
+  if (distance == 0 || speed <= 0 || accel <= 0) return 0;
+  if (distance < speed * speed / accel) return 2 * std::sqrt(distance / accel);
+  return distance / speed + speed / accel;
+}
+
+class VerifyTargets final : public Pass {
+ public:
+  std::string_view Name() const override { return "verify"; }
+
+  void Run(ir::Program& program, Diagnostics& diags) override {
+    SMTCAL_CHECK(program.compile != nullptr, "verify runs after bind");
+    CompileState& state = *program.compile;
+    const cell::Cell& cell = *state.cell;
+    for (Target& target : state.targets) {
+      if (!target.known) continue;
+      CheckLimits(target, cell.robot, diags);
+      if (target.region == nullptr) continue;
+      if (target.kind == CorrectionKind::kFixture) CheckFixtureMotion(target, state, diags);
+      CheckBudget(target, cell.robot, diags);
+    }
+    EstimateCycles(state);
+  }
+
+ private:
+  static SourceRange Where(const Target& target) { return sema::StmtRange(*target.stmt); }
+
+  static void CheckLimits(const Target& target, const cell::Robot& robot, Diagnostics& diags) {
+    static constexpr std::array<std::string_view, 4> kAxes = {"x", "y", "z", "u"};
+    static constexpr std::array<std::string_view, 4> kUnits = {"mm", "mm", "mm", "°"};
+    const Pose4& command = target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+    for (int a = 0; a < 4; ++a) {
+      if (robot.limits[a].Contains(command[a])) continue;
+      diags.Report(DiagKind::TargetBeyondRobotLimits, Where(target), TargetKeyword(*target.stmt), target.text,
+                   kAxes[a], FormatMm(command[a]), kUnits[a], FormatMm(robot.limits[a].lo),
+                   FormatMm(robot.limits[a].hi), kUnits[a]);
+    }
+  }
+
+  // The smallest shift that takes the target out of its region, over the four
+  // sides of the region and the rotations the fixture may make.
+  static void CheckFixtureMotion(const Target& target, const CompileState& state, Diagnostics& diags) {
+    const FixtureBinding& binding = state.fixtures[target.fixture];
+    const cell::Fixture& fixture = *binding.cell_fixture;
+    const cell::Region& region = *target.region;
+    Eigen::Vector3d origin = binding.nominal.translation();
+    Eigen::Vector2d arm(target.required[0] - origin.x(), target.required[1] - origin.y());
+    struct Side {
+      std::string_view direction;
+      Eigen::Vector2d outward;
+      double margin;
+    };
+    const std::array<Side, 4> sides = {{
+        {"-x", {-1, 0}, target.required[0] - region.x_mm.lo},
+        {"+x", {1, 0}, region.x_mm.hi - target.required[0]},
+        {"-y", {0, -1}, target.required[1] - region.y_mm.lo},
+        {"+y", {0, 1}, region.y_mm.hi - target.required[1]},
+    }};
+    double worst_shift = fixture.max_shift_mm;
+    const Side* worst = nullptr;
+    double worst_turn = 0;
+    for (const Side& side : sides) {
+      for (double turn : {-fixture.max_rotation_deg, fixture.max_rotation_deg}) {
+        double c = std::cos(Radians(turn)), s = std::sin(Radians(turn));
+        Eigen::Vector2d turned(c * arm.x() - s * arm.y(), s * arm.x() + c * arm.y());
+        double shift = side.margin - (turned - arm).dot(side.outward);
+        if (shift < worst_shift) {
+          worst_shift = shift;
+          worst = &side;
+          worst_turn = (turned - arm).dot(side.outward) > 0 ? turn : 0;
+        }
+      }
+    }
+    if (worst == nullptr) return;
+    std::string turn_text = worst_turn == 0 ? std::string() : fmt::format(" and turns {:+}°", worst_turn);
+    diags.Report(DiagKind::FixtureShiftLeavesRegion, Where(target), TargetKeyword(*target.stmt), target.text,
+                 FormatMm(target.required[0]), FormatMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
+                 FormatMm(region.x_mm.hi), FormatMm(region.y_mm.lo), FormatMm(region.y_mm.hi), binding.name,
+                 fmt::format("{:.3f}", std::max(0.0, worst_shift)), worst->direction, turn_text,
+                 FormatMm(fixture.max_shift_mm), FormatMm(fixture.max_rotation_deg));
+  }
+
+  static void CheckBudget(Target& target, const cell::Robot& robot, Diagnostics& diags) {
+    if (target.kind == CorrectionKind::kUncorrected) return;
+    std::string_view keyword = TargetKeyword(*target.stmt);
+    target.budget_mm = target.residual_mm + robot.repeatability_mm + target.sensor_share_mm;
+    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) return;
+    if (target.budget_mm <= target.region->tolerance_mm) return;
+    diags.Report(DiagKind::BudgetOverTolerance, Where(target), keyword, target.text,
+                 fmt::format("{:.4f}", target.budget_mm), fmt::format("{:.1e}", target.residual_mm),
+                 FormatMm(robot.repeatability_mm), fmt::format("{:.4f}", target.sensor_share_mm), target.region->name,
+                 FormatMm(target.region->tolerance_mm));
+  }
+
+  // ---------------------------------------------------------------- cycle time
+
+  struct Position {
+    Pose4 pose{};
+    bool known = false;
+  };
+
+  static double TravelTime(const cell::Robot& robot, const Pose4& from, const Pose4& to) {
+    double xy = MoveTime(std::hypot(to[0] - from[0], to[1] - from[1]), robot.xy_speed_mm_s, robot.xy_accel_mm_s2);
+    double u = MoveTime(to[3] - from[3], robot.u_speed_deg_s, robot.u_accel_deg_s2);
+    return std::max(xy, u);
+  }
+
+  // A Jump (and the approach of a Pick or Place): up to LimZ, across, down.
+  static double JumpTime(const cell::Robot& robot, const Pose4& from, const Pose4& to, double limz) {
+    double up = MoveTime(limz - from[2], robot.z_speed_mm_s, robot.z_accel_mm_s2);
+    double down = MoveTime(limz - to[2], robot.z_speed_mm_s, robot.z_accel_mm_s2);
+    return up + TravelTime(robot, from, to) + down;
+  }
+
+  static double LimZOf(const ir::Stmt& stmt, const cell::Robot& robot) {
+    const ir::Expr* limz = nullptr;
+    if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) limz = pick->limz.get();
+    if (const auto* motion = std::get_if<ir::Motion>(&stmt.node)) limz = motion->limz.get();
+    std::optional<sema::Constant> value = sema::FoldConstant(limz);
+    return value ? value->value : robot.safe_limz_mm;
+  }
+
+  // The marker scan: to each V path's start, then along it at the scan feed.
+  static double ScanTime(const cell::Robot& robot, const FixtureBinding& binding, Position& at) {
+    const cell::Fixture& fixture = *binding.cell_fixture;
+    double seconds = 0;
+    for (const cell::ScanPath& path : fixture.scan_paths) {
+      std::vector<Pose4> points;
+      for (const cell::Point2& p : path.points) {
+        points.push_back(PoseToBase(binding.nominal, {p.x(), p.y(), fixture.scan_z_mm, 0}));
+      }
+      if (at.known) seconds += JumpTime(robot, at.pose, points.front(), robot.safe_limz_mm);
+      for (std::size_t i = 1; i < points.size(); ++i) {
+        double length = std::hypot(points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]);
+        seconds += fixture.scan_speed_mm_s > 0 ? length / fixture.scan_speed_mm_s : 0;
+      }
+      at = {points.back(), true};
+    }
+    return seconds;
+  }
+
+  static void EstimateCycles(CompileState& state) {
+    const cell::Robot& robot = state.cell->robot;
+    state.cycles.clear();
+    for (const auto& [stmt, events] : state.cycle_traces) {
+      const auto& cycle = std::get<ir::Cycle>(stmt->node);
+      CycleEstimate estimate;
+      estimate.cycle = stmt;
+      estimate.fixture = cycle.fixture;
+      Position at;
+      int fixture = state.FindFixture(cycle.fixture);
+      if (fixture >= 0) estimate.scan_s = ScanTime(robot, state.fixtures[fixture], at);
+      for (const TraceEvent& event : events) {
+        if (event.kind == TraceEvent::Kind::kWait) {
+          estimate.motion_s += event.wait_s;
+          continue;
+        }
+        const Target& target = state.targets[event.target];
+        if (!target.known) continue;
+        const Pose4& to = target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+        bool jump = !std::holds_alternative<ir::Motion>(target.stmt->node) ||
+                    std::get<ir::Motion>(target.stmt->node).kind == ir::MotionKind::Jump;
+        if (at.known) {
+          estimate.motion_s += jump ? JumpTime(robot, at.pose, to, LimZOf(*target.stmt, robot))
+                                    : TravelTime(robot, at.pose, to) +
+                                          MoveTime(to[2] - at.pose[2], robot.z_speed_mm_s, robot.z_accel_mm_s2);
+        }
+        if (const auto* pick = std::get_if<ir::PickPlace>(&target.stmt->node)) {
+          bool place = pick->kind == ir::PickPlaceKind::Place;
+          estimate.motion_s += place ? robot.place_time_s : robot.pick_time_s;
+          estimate.placements += place ? 1 : 0;
+        }
+        at = {to, true};
+      }
+      state.cycles.push_back(estimate);
+    }
+    std::sort(state.cycles.begin(), state.cycles.end(), [](const CycleEstimate& a, const CycleEstimate& b) {
+      return std::tie(a.cycle->loc.file, a.cycle->loc.line, a.cycle->loc.column) <
+             std::tie(b.cycle->loc.file, b.cycle->loc.line, b.cycle->loc.column);
+    });
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Pass> CreateVerifyTargetsPass() { return std::make_unique<VerifyTargets>(); }
+
+}  // namespace smtcal

@@ -1,0 +1,116 @@
+// Building tables from raw measurements: the per-node statistics, and the
+// warnings for noisy nodes and shifted sets (with no false alarms on clean
+// data). Random data print their seed on failure.
+#include <cmath>
+#include <cstdlib>
+#include <random>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "calibration/error_table_build.h"
+
+namespace smtcal {
+namespace {
+
+std::uint64_t BaseSeed() {
+  const char* text = std::getenv("SMTCAL_TEST_SEED");
+  return text != nullptr ? std::strtoull(text, nullptr, 10) : 20240521;
+}
+
+RawMeasurement M(TableAxis axis, double x, double y, long long set, long long rep, double e) {
+  RawMeasurement m;
+  m.axis = axis;
+  m.x_mm = x;
+  m.y_mm = y;
+  m.set = set;
+  m.repetition = rep;
+  m.error_mm = e;
+  return m;
+}
+
+TEST(TableBuild, NodeStatistics) {
+  // One node: set 1 = {1, 2, 3}, set 2 = {5, 6, 7} (µm).
+  std::vector<RawMeasurement> raw;
+  for (int r = 1; r <= 3; ++r) raw.push_back(M(TableAxis::X, 0, 0, 1, r, 0.001 * r));
+  for (int r = 1; r <= 3; ++r) raw.push_back(M(TableAxis::X, 0, 0, 2, r, 0.001 * (r + 4)));
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::vector<NodeSummary> nodes = SummarizeNodes(raw, diags);
+  ASSERT_EQ(nodes.size(), 1u);
+  const NodeSummary& n = nodes[0];
+  EXPECT_NEAR(n.mean_mm, 0.004, 1e-15);
+  // Sample stddev of {1,2,3,5,6,7}: sum of squares 9+4+1+1+4+9 = 28 over 5.
+  EXPECT_NEAR(*n.stddev_mm, 0.001 * std::sqrt(28.0 / 5), 1e-15);
+  // Pooled within the sets: (2 + 2) / (6 - 2) = 1 -> 1 µm.
+  EXPECT_NEAR(*n.pooled_stddev_mm, 0.001, 1e-15);
+  EXPECT_NEAR(n.set_mean_spread_mm, 0.004, 1e-15);
+  EXPECT_NEAR(*n.set_spread_weight, std::sqrt(2.0 / 3), 1e-15);
+}
+
+TEST(TableBuild, ARepetitionGivenTwiceIsAnError) {
+  std::vector<RawMeasurement> raw = {M(TableAxis::Y, 1, 2, 1, 1, 0.001), M(TableAxis::Y, 1, 2, 1, 1, 0.002)};
+  SourceManager sources;
+  Diagnostics diags(sources);
+  EXPECT_FALSE(BuildErrorTable("t", raw, SourceLoc{}, diags).has_value());
+  ASSERT_EQ(diags.all().size(), 1u);
+  EXPECT_EQ(diags.all()[0].kind, DiagKind::RawDuplicateMeasurement);
+}
+
+// The paper's measurement: 11 x 11 nodes per axis, 2 sets of 10, 2.5 µm
+// scatter. `noisy` (axis, node) scatters 10 times more; `shifted` has its
+// second set moved by 15 µm.
+std::vector<RawMeasurement> Measure(std::mt19937_64& rng, int noisy, int shifted) {
+  std::normal_distribution<double> noise(0, 0.0025);  // any normal will do here
+  std::vector<RawMeasurement> raw;
+  for (TableAxis axis : kTableAxes) {
+    for (int set = 1; set <= 2; ++set) {
+      for (int node = 0; node < 121; ++node) {
+        const int id = static_cast<int>(axis) * 121 + node;
+        for (int rep = 1; rep <= 10; ++rep) {
+          double e = 0.01 * std::sin(node) + noise(rng) * (id == noisy ? 10 : 1);
+          if (id == shifted && set == 2) e += 0.015;
+          raw.push_back(M(axis, 5.0 * (node % 11), 5.0 * (node / 11), set, rep, std::round(e * 1000) / 1000));
+        }
+      }
+    }
+  }
+  return raw;
+}
+
+TEST(TableBuild, CleanDataRaiseNoAlarm) {
+  for (int k = 0; k < 20; ++k) {
+    const std::uint64_t seed = BaseSeed() + static_cast<std::uint64_t>(k);
+    SCOPED_TRACE(fmt::format("seed {}", seed));
+    std::mt19937_64 rng(seed);
+    SourceManager sources;
+    Diagnostics diags(sources);
+    std::optional<ErrorTable> table = BuildErrorTable("t", Measure(rng, -1, -1), SourceLoc{}, diags);
+    ASSERT_TRUE(table.has_value()) << diags.RenderText();
+    EXPECT_TRUE(diags.all().empty()) << diags.RenderText();
+    EXPECT_EQ((*table)[TableAxis::X].count, std::vector<int>(121, 20));
+  }
+}
+
+TEST(TableBuild, ANoisyNodeAndAShiftedSetAreReported) {
+  for (int k = 0; k < 20; ++k) {
+    const std::uint64_t seed = BaseSeed() + 100 + static_cast<std::uint64_t>(k);
+    SCOPED_TRACE(fmt::format("seed {}", seed));
+    std::mt19937_64 rng(seed);
+    const int noisy = 60, shifted = 121 + 17;  // (25, 25) of the x table; (30, 5) of the y table
+    SourceManager sources;
+    Diagnostics diags(sources);
+    std::optional<ErrorTable> table = BuildErrorTable("t", Measure(rng, noisy, shifted), SourceLoc{}, diags);
+    ASSERT_TRUE(table.has_value()) << diags.RenderText();  // warnings only: the table is still built
+    ASSERT_EQ(diags.all().size(), 2u) << diags.RenderText();
+    EXPECT_EQ(diags.all()[0].kind, DiagKind::RawNoisyNode);
+    EXPECT_NE(diags.all()[0].message.find("node (25.000, 25.000) of the x table"), std::string::npos)
+        << diags.all()[0].message;
+    EXPECT_EQ(diags.all()[1].kind, DiagKind::RawSetShift);
+    EXPECT_NE(diags.all()[1].message.find("node (30.000, 5.000) of the y table"), std::string::npos)
+        << diags.all()[1].message;
+  }
+}
+
+}  // namespace
+}  // namespace smtcal
