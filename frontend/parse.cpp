@@ -1,52 +1,57 @@
 // The .place parser: source text -> ir::Program, mistakes -> Diagnostics.
 //
 // Three steps, each working on the output of the one before:
-//  1. Lex the whole file. The bytes go to ANTLR one byte per code point, so
-//     ANTLR's columns are byte columns and invalid UTF-8 cannot throw.
+//  1. Lex the whole file into compact tokens (frontend/place_lexer.h, by
+//     hand; the generated lexer is only the differential test's reference).
 //  2. Check the line structure (PreScan). .place has one statement per line,
 //     and blocks open and close with the first word of a line, so block
 //     mistakes ("Next" without "For", a missing "EndIf", a Point declared
 //     inside a Function) are found here, with messages that name the block.
-//     The pre-scan repairs what it reports -- it drops stray lines, inserts
-//     the missing closers and cuts over-long expressions -- so ANTLR always
-//     sees well-nested blocks, its errors stay inside one line, and its
+//     The pre-scan repairs what it reports -- it drops stray lines, closes
+//     the blocks left open and cuts over-long expressions -- so the blocks
+//     are well nested, every error of ANTLR's stays inside one line, and its
 //     recursion depth stays bounded.
-//  3. Parse with ANTLR, one top-level line (a declaration or a whole
-//     Function) at a time, turning each into IR and freeing its parse tree
-//     before the next. Errors are recovered at the end of their line
+//  3. Parse with ANTLR one line at a time: the line's tokens go through one
+//     TokenSource (LineTokens) and one token stream to the one parser, the
+//     grammar's rule for the line's kind (known from its first word) parses
+//     them, the line's IR is built from the rule's labelled elements
+//     (IrBuilder), and the line's tokens and parse tree are freed before the
+//     next line. Blocks are put together from the pre-scan's nesting
+//     (BlockBuilder). Errors are recovered at the end of their line
 //     (LineErrorStrategy) and rewritten into plain words from the rule and
-//     the expected tokens (SyntaxErrorListener). One visitor (IrBuilder)
-//     builds the IR; a statement whose line has a syntax error is dropped.
+//     the expected tokens (SyntaxErrorListener). A statement whose line has
+//     a syntax error is dropped, and so is a block whose first line has one.
 // All syntax errors are collected, sorted by position and capped, so a file
-// of garbage gives a few clear errors. No ANTLR type or exception leaves
-// this file.
+// of garbage gives a few clear errors. No ANTLR type leaves this file; of
+// ANTLR's exceptions only its recognition errors are caught (running out of
+// memory is not a syntax error and leaves as std::bad_alloc).
 #include "frontend/parse.h"
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <system_error>
-#include <unordered_set>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "frontend/place_lexer.h"
+
 // ANTLR's headers #undef the EOF macro of <cstdio>; they come after every
 // standard header that might include it.
-#include "PlaceBaseVisitor.h"
-#include "PlaceLexer.h"
 #include "PlaceParser.h"
 
 namespace smtcal {
 namespace {
 
 using antlr4::Token;
-using grammar::PlaceLexer;
 using grammar::PlaceParser;
 using P = grammar::PlaceParser;
 
@@ -145,17 +150,10 @@ const std::vector<std::string>& DeclarationKeywords() {
   return words;
 }
 
-// Feeds ANTLR the file's bytes, one code point per byte. A UTF-8 byte order
-// mark becomes three spaces, so it is skipped and columns stay byte columns.
-class ByteStream : public antlr4::ANTLRInputStream {
- public:
-  explicit ByteStream(std::string_view text) {
-    _data.reserve(text.size());
-    for (unsigned char c : text) _data.push_back(c);
-    if (text.substr(0, 3) == "\xEF\xBB\xBF") _data[0] = _data[1] = _data[2] = U' ';
-    p = 0;
-  }
-};
+// A PlaceToken's type as ANTLR numbers it (the end of file is Token::EOF).
+std::size_t TypeOf(const PlaceToken& token) {
+  return token.type == kPlaceEof ? Token::EOF : static_cast<std::size_t>(token.type);
+}
 
 // ------------------------------------------------------------------ the session
 
@@ -165,20 +163,33 @@ struct PendingError {
   std::vector<std::pair<SourceRange, std::string>> notes;
 };
 
-// One source line as the lexer saw it.
+// One source line as the lexer saw it. Its tokens are contiguous in the
+// session's token list: the code, then the comment, then the NEWLINE.
 struct Line {
-  std::vector<Token*> code;   // default-channel tokens except the NEWLINE
-  Token* newline = nullptr;   // absent on the last line without a newline
-  Token* comment = nullptr;   // the ' comment, if any
+  std::uint32_t first = 0;   // the code the parser gets: tokens [first, end)
+  std::uint32_t end = 0;
+  std::int32_t comment = -1;  // the ' comment's token, if any
+  std::int32_t newline = -1;  // the NEWLINE's token; -1 on a last line without one
   bool had_code = false;      // the line held a statement (even if dropped)
   bool error = false;         // a syntax error was reported on this line
-  std::vector<std::unique_ptr<Token>> insert_before;  // closers the pre-scan adds
+  // The blocks the pre-scan closes before this line: closers_[closers_first ..+ closers_count).
+  std::uint32_t closers_first = 0;
+  std::uint32_t closers_count = 0;
+  std::size_t size() const { return end - first; }
+  bool empty() const { return end == first; }
+};
+
+// A closer (Fend, Next, EndIf, EndCycle) the pre-scan adds where a block
+// was left open; it takes the position of the token `at`.
+struct Closer {
+  std::size_t type;
+  std::uint32_t at;  // token index
 };
 
 // A block the pre-scan has seen open.
 struct OpenBlock {
   std::size_t type;  // FUNCTION, FOR, IF or CYCLE
-  Token* opener;
+  std::uint32_t opener;  // token index
   std::string name;  // the function's name
   bool seen_else = false;
 };
@@ -200,14 +211,31 @@ std::string Describe(const OpenBlock& open) {
 
 class Session {
  public:
-  Session(std::uint32_t file, Diagnostics& diags)
-      : file_(file), diags_(diags), text_(diags.sources().File(file).text) {}
+  Session(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags)
+      : file_(file), diags_(diags), text_(diags.sources().File(file).text), tokens_(std::move(tokens)) {}
 
   ir::Program Run();
 
-  // --- tokens and locations
+  // --- tokens and locations: the lexer's tokens
+  const PlaceToken& At(std::uint32_t index) const { return tokens_[index]; }
+  std::string_view Text(const PlaceToken& token) const {
+    return std::string_view(text_).substr(token.start, token.length);
+  }
+  SourceLoc Loc(const PlaceToken& token) const { return SourceLoc{file_, token.line, token.column + 1}; }
+  std::uint32_t Length(const PlaceToken& token) const { return std::max<std::uint32_t>(1, token.length); }
+  SourceRange Range(const PlaceToken& token) const { return SourceRange(Loc(token), Length(token)); }
+  // "'Jump'", "end of line" or "end of file": how a found token is named.
+  std::string Display(const PlaceToken& token) const {
+    if (token.type == kPlaceEof) return "end of file";
+    if (TypeOf(token) == P::NEWLINE) return "end of line";
+    return fmt::format("'{}'", Text(token));
+  }
+  std::span<const PlaceToken> Code(const Line& line) const {
+    return std::span<const PlaceToken>(tokens_.data() + line.first, line.size());
+  }
+
+  // --- the same for the tokens ANTLR holds (LineTokens made them)
   std::string_view Text(const Token* token) const {
-    if (synthetic_.count(token) != 0) return Spelling(token->getType());
     std::size_t start = token->getStartIndex();
     std::size_t stop = token->getStopIndex();
     if (token->getType() == Token::EOF || stop < start || stop >= text_.size()) return {};
@@ -221,7 +249,6 @@ class Session {
     return std::max<std::uint32_t>(1, static_cast<std::uint32_t>(Text(token).size()));
   }
   SourceRange Range(const Token* token) const { return SourceRange(Loc(token), Length(token)); }
-  // "'Jump'", "end of line" or "end of file": how a found token is named.
   std::string Display(const Token* token) const {
     if (token->getType() == Token::EOF) return "end of file";
     if (token->getType() == P::NEWLINE) return "end of line";
@@ -248,71 +275,69 @@ class Session {
   }
   bool LineHasError(std::size_t line) const { return line < lines_.size() && lines_[line].error; }
   const Line* LineAt(std::size_t line) const { return line < lines_.size() ? &lines_[line] : nullptr; }
+  const PlaceToken* CommentToken(std::size_t line) const {
+    const Line* info = LineAt(line);
+    return info != nullptr && info->comment >= 0 ? &tokens_[static_cast<std::size_t>(info->comment)] : nullptr;
+  }
   std::uint32_t file() const { return file_; }
   std::uint32_t last_line() const { return static_cast<std::uint32_t>(lines_.size() - 1); }
+  const std::vector<Line>& lines() const { return lines_; }
+  std::span<const Closer> ClosersBefore(const Line& line) const {
+    return std::span<const Closer>(closers_.data() + line.closers_first, line.closers_count);
+  }
+  std::span<const Closer> ClosersAtEnd() const { return closers_at_end_; }
+  const PlaceToken& EndOfFile() const { return tokens_.back(); }
 
   // Reports an ANTLR parse error in plain words (SyntaxErrorListener).
   void ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext* ctx, Token* found,
                         const antlr4::misc::IntervalSet& expected, bool deep);
 
  private:
-  void Lex(antlr4::ANTLRErrorListener& listener);
+  void SplitLines();
   void PreScan();
   void CheckCharacters(Line& line);
   void CheckExpressionSize(Line& line);
   void CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& misplaced_run);
   bool IfHasBlock(std::size_t if_line) const;
-  void CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, Line& line, Token* at, bool quiet);
+  void CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, std::uint32_t at, bool quiet);
   // Error(), unless the line already has one: one error per line.
   template <typename... Args>
   void LineError(const Line& line, DiagKind kind, SourceRange range, Args... args) {
     if (!line.error) Error(kind, range, args...);
   }
-  void Drop(Line& line) { line.code.clear(); line.error = true; }
+  void Drop(Line& line) {
+    line.end = line.first;
+    line.error = true;
+  }
   void CloseAtEndOfFile(std::vector<OpenBlock>& stack, bool report);
-  std::unique_ptr<Token> MakeToken(std::size_t type, const Token* at);
-  std::vector<std::unique_ptr<Token>> ParserTokens();
   void Flush();
 
   std::uint32_t file_;
   Diagnostics& diags_;
   const std::string& text_;
-  std::unique_ptr<ByteStream> stream_;
-  std::unique_ptr<PlaceLexer> lexer_;
-  std::vector<std::unique_ptr<Token>> lexed_;  // every token the lexer made
-  std::vector<Line> lines_;                    // by line number; [0] unused
-  std::vector<std::unique_ptr<Token>> tail_;   // closers added at end of file
-  std::unordered_set<const Token*> synthetic_;
+  std::vector<PlaceToken> tokens_;  // every token the lexer made, EOF last
+  std::vector<Line> lines_;         // by line number; [0] unused
+  std::vector<Closer> closers_;     // the closers before lines, in line order
+  std::vector<Closer> closers_at_end_;  // closers added at the end of the file
   std::vector<PendingError> errors_;
 };
 
 // ------------------------------------------------------------------ step 1: lex
 
-void Session::Lex(antlr4::ANTLRErrorListener& listener) {
-  stream_ = std::make_unique<ByteStream>(text_);
-  lexer_ = std::make_unique<PlaceLexer>(stream_.get());
-  // BAD_CHAR takes any byte no other token does, so the lexer has nothing to
-  // report; should it ever, the message goes through our listener.
-  lexer_->removeErrorListeners();
-  lexer_->addErrorListener(&listener);
-  for (;;) {
-    std::unique_ptr<Token> token = lexer_->nextToken();
-    bool eof = token->getType() == Token::EOF;
-    // Remember each token's place in lexed_, so ParserTokens() can move it.
-    static_cast<antlr4::CommonToken*>(token.get())->setTokenIndex(lexed_.size());
-    lexed_.push_back(std::move(token));
-    if (eof) break;
-  }
-  std::size_t lines = std::max<std::size_t>(lexed_.back()->getLine(), 1) + 1;
+// The tokens by line. Code tokens come first on a line, then a comment, then
+// the NEWLINE, so a line's code is the range before its comment or NEWLINE.
+void Session::SplitLines() {
+  std::size_t lines = std::max<std::size_t>(tokens_.back().line, 1) + 1;
   lines_.resize(lines);
-  for (const auto& token : lexed_) {
-    Line& line = lines_[std::min<std::size_t>(token->getLine(), lines - 1)];
-    switch (token->getType()) {
-      case Token::EOF: break;
-      case P::NEWLINE: line.newline = token.get(); break;
-      case P::COMMENT: line.comment = token.get(); break;
+  for (std::uint32_t i = 0; i + 1 < tokens_.size(); ++i) {  // all but EOF
+    const PlaceToken& token = tokens_[i];
+    Line& line = lines_[std::min<std::size_t>(token.line, lines - 1)];
+    switch (TypeOf(token)) {
+      case P::NEWLINE: line.newline = static_cast<std::int32_t>(i); break;
+      case P::COMMENT: line.comment = static_cast<std::int32_t>(i); break;
       default:
-        line.code.push_back(token.get());
+        if (!line.had_code) line.first = i;
+        line.end = i + 1;
         line.had_code = true;
     }
   }
@@ -325,14 +350,16 @@ void Session::PreScan() {
   bool misplaced_run = false;  // inside a run of statements outside any Function
   for (std::size_t n = 1; n < lines_.size(); ++n) {
     Line& line = lines_[n];
+    line.closers_first = static_cast<std::uint32_t>(closers_.size());
     CheckCharacters(line);
-    if (line.code.empty()) continue;
+    if (line.empty()) continue;
     CheckStructure(line, stack, misplaced_run);
+    line.closers_count = static_cast<std::uint32_t>(closers_.size()) - line.closers_first;
     CheckExpressionSize(line);
     if (stack.size() > kMaxBlockDepth) {
       // Stop here: drop this line and the rest, close what is open silently.
-      Error(DiagKind::BlocksTooDeep, Range(stack.back().opener), kMaxBlockDepth);
-      for (std::size_t rest = n + 1; rest < lines_.size(); ++rest) lines_[rest].code.clear();
+      Error(DiagKind::BlocksTooDeep, Range(At(stack.back().opener)), kMaxBlockDepth);
+      for (std::size_t rest = n + 1; rest < lines_.size(); ++rest) lines_[rest].end = lines_[rest].first;
       stack.pop_back();
       Drop(line);
       return CloseAtEndOfFile(stack, false);
@@ -343,34 +370,33 @@ void Session::PreScan() {
 
 // Closes the blocks still open at the end of the file, innermost first.
 void Session::CloseAtEndOfFile(std::vector<OpenBlock>& stack, bool report) {
-  const Token* eof = lexed_.back().get();
+  const auto eof = static_cast<std::uint32_t>(tokens_.size() - 1);
   while (!stack.empty()) {
     const OpenBlock& open = stack.back();
     std::size_t closer = CloserOf(open.type);
     if (report) {
-      ErrorElsewhere(DiagKind::MissingBlockEndAtEof, Range(open.opener), std::string(Spelling(closer)),
-                     Describe(open), open.opener->getLine());
+      ErrorElsewhere(DiagKind::MissingBlockEndAtEof, Range(At(open.opener)), std::string(Spelling(closer)),
+                     Describe(open), static_cast<std::size_t>(At(open.opener).line));
     }
-    tail_.push_back(MakeToken(P::NEWLINE, eof));
-    tail_.push_back(MakeToken(closer, eof));
+    closers_at_end_.push_back({closer, eof});
     stack.pop_back();
   }
-  if (!tail_.empty()) tail_.push_back(MakeToken(P::NEWLINE, eof));
 }
 
 // BAD_CHAR tokens: one error for the first per line (a UTF-8 sequence is one
 // character); all of them leave the line so ANTLR never sees them.
 void Session::CheckCharacters(Line& line) {
   bool reported = false;
-  std::vector<Token*> kept;
-  for (Token* token : line.code) {
-    if (token->getType() != P::BAD_CHAR) {
-      kept.push_back(token);
+  std::uint32_t kept = line.first;
+  for (std::uint32_t i = line.first; i < line.end; ++i) {
+    const PlaceToken token = tokens_[i];
+    if (TypeOf(token) != P::BAD_CHAR) {
+      tokens_[kept++] = token;
       continue;
     }
     if (reported) continue;
     reported = true;
-    std::size_t at = token->getStartIndex();
+    std::size_t at = token.start;
     auto byte = static_cast<unsigned char>(text_[at]);
     std::size_t length = byte >= 0xF0 ? 4 : byte >= 0xE0 ? 3 : byte >= 0xC0 ? 2 : 1;
     bool valid_utf8 = byte >= 0xC2 && byte <= 0xF4 && at + length <= text_.size();
@@ -396,60 +422,46 @@ void Session::CheckCharacters(Line& line) {
     }
     Error(DiagKind::UnexpectedCharacter, SourceRange(Loc(token), bytes), what, hint);
   }
-  line.code = std::move(kept);
+  line.end = kept;
 }
 
 // Counts operators and '(' on the line; cuts the line where the count
 // passes the limit, so ANTLR's recursion stays bounded.
 void Session::CheckExpressionSize(Line& line) {
   int count = 0;
-  for (std::size_t i = 0; i < line.code.size(); ++i) {
-    std::size_t type = line.code[i]->getType();
+  for (std::uint32_t i = line.first; i < line.end; ++i) {
+    std::size_t type = TypeOf(tokens_[i]);
     if (type == P::LPAREN || type == P::NOT || IsBinaryOperator(type)) ++count;
     if (count > kMaxExpressionSize) {
-      LineError(line, DiagKind::ExpressionTooBig, Range(line.code[i]), kMaxExpressionSize);
-      line.code.resize(i);
+      LineError(line, DiagKind::ExpressionTooBig, Range(tokens_[i]), kMaxExpressionSize);
+      line.end = i;
       return;
     }
   }
 }
 
-std::unique_ptr<Token> Session::MakeToken(std::size_t type, const Token* at) {
-  // A real source: ANTLR's recovery asks a token for its source when it
-  // conjures a missing token next to it.
-  std::pair<antlr4::TokenSource*, antlr4::CharStream*> source(lexer_.get(), stream_.get());
-  auto token = std::make_unique<antlr4::CommonToken>(source, type, Token::DEFAULT_CHANNEL, at->getStartIndex(),
-                                                     at->getStartIndex());
-  token->setLine(at->getLine());
-  token->setCharPositionInLine(at->getCharPositionInLine());
-  token->setText(std::string(type == P::NEWLINE ? "\n" : Spelling(type)));
-  synthetic_.insert(token.get());
-  return token;
-}
-
-void Session::CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, Line& line, Token* at,
-                               bool quiet) {
+void Session::CloseBlocksAbove(std::size_t keep, std::vector<OpenBlock>& stack, std::uint32_t at, bool quiet) {
   while (stack.size() > keep) {
     const OpenBlock& open = stack.back();
     std::size_t closer = CloserOf(open.type);
     std::string what = Describe(open);
     if (!quiet) {
-      PendingError& error = Error(DiagKind::MissingBlockEnd, Range(at), std::string(Spelling(closer)), what,
-                                  open.opener->getLine());
-      error.notes.emplace_back(Range(open.opener), fmt::format("{} starts here", what));
+      PendingError& error = Error(DiagKind::MissingBlockEnd, Range(At(at)), std::string(Spelling(closer)), what,
+                                  static_cast<std::size_t>(At(open.opener).line));
+      error.notes.emplace_back(Range(At(open.opener)), fmt::format("{} starts here", what));
     }
-    line.insert_before.push_back(MakeToken(closer, at));
-    line.insert_before.push_back(MakeToken(P::NEWLINE, at));
+    closers_.push_back({closer, at});
     stack.pop_back();
   }
 }
 
 // The block structure, from the first token of each line.
 void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& misplaced_run) {
-  Token* first = line.code.front();
-  std::size_t type = first->getType();
+  const std::uint32_t first_index = line.first;
+  const PlaceToken& first = tokens_[first_index];
+  std::size_t type = TypeOf(first);
   bool quiet = line.error;  // a bad character was reported on this line
-  std::size_t second = line.code.size() > 1 ? line.code[1]->getType() : std::size_t{P::NEWLINE};
+  std::size_t second = line.size() > 1 ? TypeOf(tokens_[line.first + 1]) : std::size_t{P::NEWLINE};
   auto innermost = [&](std::size_t block_type) -> std::ptrdiff_t {
     for (std::size_t i = stack.size(); i-- > 0;) {
       if (stack[i].type == block_type) return static_cast<std::ptrdiff_t>(i);
@@ -461,38 +473,35 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     misplaced_run = true;
     Drop(line);
   };
-  // "If c Then Jump P": THEN before the end of the line.
-  auto then_not_last = [&]() -> Token* {
-    for (std::size_t i = 0; i + 1 < line.code.size(); ++i) {
-      if (line.code[i]->getType() == P::THEN) return line.code[i];
+  // "If c Then Jump P": THEN before the end of the line (its token index).
+  auto then_not_last = [&]() -> std::optional<std::uint32_t> {
+    for (std::uint32_t i = line.first; i + 1 < line.end; ++i) {
+      if (TypeOf(tokens_[i]) == P::THEN) return i;
     }
-    return nullptr;
+    return std::nullopt;
   };
-  auto cut_after = [&](Token* token) {
-    auto end = std::find(line.code.begin(), line.code.end(), token) + 1;
-    line.code.erase(end, line.code.end());
-  };
+  auto cut_after = [&](std::uint32_t index) { line.end = index + 1; };
 
   switch (type) {
     case P::FUNCTION: {
-      CloseBlocksAbove(0, stack, line, first, quiet);
+      CloseBlocksAbove(0, stack, first_index, quiet);
       misplaced_run = false;
-      std::string name = second == P::ID ? std::string(Text(line.code[1])) : std::string();
-      stack.push_back({type, first, std::move(name), false});
+      std::string name = second == P::ID ? std::string(Text(tokens_[line.first + 1])) : std::string();
+      stack.push_back({type, first_index, std::move(name), false});
       return;
     }
     case P::FOR:
     case P::IF:
     case P::CYCLE:
       if (stack.empty()) return misplaced(fmt::format("'{}'", Spelling(type)));
-      if (Token* then = type == P::IF ? then_not_last() : nullptr) {
-        LineError(line, DiagKind::SingleLineIf, Range(then), "Then");
+      if (std::optional<std::uint32_t> then = type == P::IF ? then_not_last() : std::nullopt) {
+        LineError(line, DiagKind::SingleLineIf, Range(tokens_[*then]), "Then");
         // A block If with something after Then keeps its header; a SPEL
         // single-line If (no EndIf follows) opens no block.
-        if (!IfHasBlock(then->getLine())) return Drop(line);
-        cut_after(then);
+        if (!IfHasBlock(tokens_[*then].line)) return Drop(line);
+        cut_after(*then);
       }
-      stack.push_back({type, first, {}, false});
+      stack.push_back({type, first_index, {}, false});
       return;
     case P::ELSEIF:
     case P::ELSE: {
@@ -502,16 +511,16 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
         LineError(line, DiagKind::UnexpectedBlockEnd, Range(first), std::string(Spelling(type)), "If");
         return Drop(line);
       }
-      CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, line, first, quiet);
+      CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, first_index, quiet);
       if (stack.back().seen_else) {
         LineError(line, DiagKind::ElseAfterElse, Range(first), std::string(Spelling(type)),
-                  stack.back().opener->getLine());
+                  static_cast<std::size_t>(At(stack.back().opener).line));
         return Drop(line);
       }
       if (type == P::ELSE) stack.back().seen_else = true;
-      if (Token* then = type == P::ELSEIF ? then_not_last() : nullptr) {
-        LineError(line, DiagKind::SingleLineIf, Range(then), "Then");
-        cut_after(then);
+      if (std::optional<std::uint32_t> then = type == P::ELSEIF ? then_not_last() : std::nullopt) {
+        LineError(line, DiagKind::SingleLineIf, Range(tokens_[*then]), "Then");
+        cut_after(*then);
       }
       return;
     }
@@ -530,7 +539,7 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
                   std::string(Spelling(opener)));
         return Drop(line);
       }
-      CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, line, first, quiet);
+      CloseBlocksAbove(static_cast<std::size_t>(at) + 1, stack, first_index, quiet);
       stack.pop_back();
       return;
     }
@@ -594,14 +603,13 @@ bool Session::IfHasBlock(std::size_t if_line) const {
   if (errors_.size() > kMaxSyntaxErrors) return false;
   int depth = 0;
   for (std::size_t n = if_line + 1; n < lines_.size(); ++n) {
-    if (lines_[n].code.empty()) continue;
-    switch (lines_[n].code.front()->getType()) {
+    const Line& line = lines_[n];
+    if (line.empty()) continue;
+    switch (TypeOf(tokens_[line.first])) {
       case P::FOR: case P::CYCLE: ++depth; break;
-      case P::IF: {
-        const std::vector<Token*>& code = lines_[n].code;
-        if (code.back()->getType() == P::THEN) ++depth;
+      case P::IF:
+        if (TypeOf(tokens_[line.end - 1]) == P::THEN) ++depth;
         break;
-      }
       case P::ELSEIF: case P::ELSE:
         if (depth == 0) return true;
         break;
@@ -622,35 +630,110 @@ bool Session::IfHasBlock(std::size_t if_line) const {
   return false;
 }
 
-// The token list ANTLR parses: the kept code of each line, the closers the
-// pre-scan inserted, the NEWLINEs and EOF. The tokens move out of lexed_;
-// the objects stay put, so Line's pointers (and the comments, which stay in
-// lexed_) remain valid.
-std::vector<std::unique_ptr<Token>> Session::ParserTokens() {
-  std::vector<std::unique_ptr<Token>> out;
-  const Token* eof = lexed_.back().get();  // never moved: no line holds it
-  auto take = [&](Token* token) { out.push_back(std::move(lexed_[token->getTokenIndex()])); };
-  for (Line& line : lines_) {
-    for (auto& token : line.insert_before) out.push_back(std::move(token));
-    for (Token* token : line.code) take(token);
-    if (line.newline != nullptr) take(line.newline);
-  }
-  // The grammar wants every line to end in NEWLINE (see Place.g4).
-  if (out.empty() || out.back()->getType() != P::NEWLINE) out.push_back(MakeToken(P::NEWLINE, eof));
-  for (auto& token : tail_) out.push_back(std::move(token));
-  out.push_back(MakeToken(Token::EOF, eof));
-  return out;
-}
+// ------------------------------------------------------------------ step 3: ANTLR, one line at a time
 
-// ------------------------------------------------------------------ step 3: ANTLR errors
+// One line's tokens for the parser: the line's code as the pre-scan left it,
+// its NEWLINE (one at the end-of-file position for a last line without one)
+// and EOF. The parser reads them through this token stream, which is also
+// their TokenSource (ANTLR's error recovery asks a token for its source's
+// factory when it makes up a missing token). The tokens are ANTLR
+// CommonTokens that point into the source text by byte offsets; their
+// objects are made once and reused for every line, so a line costs no
+// allocation per token (CommonTokenStream over a TokenSource would make and
+// free one 112-byte object per token, the largest cost of a parse).
+class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
+ public:
+  explicit LineTokens(const Session& session) : session_(session) {}
+
+  void Start(const Line& line) {
+    std::span<const PlaceToken> code = session_.Code(line);
+    const PlaceToken& newline =
+        line.newline >= 0 ? session_.At(static_cast<std::uint32_t>(line.newline)) : session_.EndOfFile();
+    size_ = 0;
+    for (const PlaceToken& token : code) Set(token, TypeOf(token));
+    Set(newline, P::NEWLINE);
+    Set(session_.EndOfFile(), Token::EOF);
+    p_ = 0;
+  }
+
+  // --- TokenStream
+  Token* LT(ssize_t k) override {
+    if (k == 0) return nullptr;
+    if (k < 0) return -k <= static_cast<ssize_t>(p_) ? tokens_[p_ + static_cast<std::size_t>(k)].get() : nullptr;
+    return tokens_[std::min(p_ + static_cast<std::size_t>(k) - 1, size_ - 1)].get();
+  }
+  Token* get(std::size_t index) const override { return tokens_[std::min(index, size_ - 1)].get(); }
+  antlr4::TokenSource* getTokenSource() const override { return const_cast<LineTokens*>(this); }
+  // The texts only feed ANTLR's own messages, which SyntaxErrorListener drops.
+  std::string getText(const antlr4::misc::Interval&) override { return {}; }
+  std::string getText() override { return {}; }
+  std::string getText(antlr4::RuleContext*) override { return {}; }
+  std::string getText(Token*, Token*) override { return {}; }
+  void consume() override {
+    if (LA(1) == Token::EOF) throw antlr4::IllegalStateException("cannot consume EOF");
+    ++p_;
+  }
+  std::size_t LA(ssize_t i) override {
+    Token* token = LT(i);
+    return token != nullptr ? token->getType() : Token::INVALID_TYPE;
+  }
+  ssize_t mark() override { return 0; }
+  void release(ssize_t) override {}
+  std::size_t index() override { return p_; }
+  void seek(std::size_t index) override { p_ = std::min(index, size_ - 1); }
+  std::size_t size() override { return size_; }
+
+  // --- TokenSource (the parser never pulls tokens from it)
+  std::unique_ptr<Token> nextToken() override { return nullptr; }
+  std::size_t getLine() const override { return p_ < size_ ? tokens_[p_]->getLine() : 0; }
+  std::size_t getCharPositionInLine() override { return p_ < size_ ? tokens_[p_]->getCharPositionInLine() : 0; }
+  antlr4::CharStream* getInputStream() override { return nullptr; }
+  std::string getSourceName() const override { return "line"; }
+  std::string getSourceName() override { return "line"; }
+  antlr4::TokenFactory<antlr4::CommonToken>* getTokenFactory() override {
+    return antlr4::CommonTokenFactory::DEFAULT.get();
+  }
+
+ private:
+  void Set(const PlaceToken& from, std::size_t type) {
+    if (size_ == tokens_.size()) {
+      tokens_.push_back(std::make_unique<antlr4::CommonToken>(
+          std::pair<antlr4::TokenSource*, antlr4::CharStream*>(this, nullptr), Token::INVALID_TYPE,
+          Token::DEFAULT_CHANNEL, 0, 0));
+    }
+    antlr4::CommonToken& token = *tokens_[size_];
+    token.setType(type);
+    // A token of no length (the end of file, a NEWLINE made up there) stops
+    // where it starts, beyond the text: its text is empty.
+    token.setStartIndex(from.start);
+    token.setStopIndex(from.length == 0 ? from.start : from.start + from.length - 1);
+    token.setLine(from.line);
+    token.setCharPositionInLine(from.column);
+    token.setTokenIndex(size_);
+    ++size_;
+  }
+
+  const Session& session_;
+  std::vector<std::unique_ptr<antlr4::CommonToken>> tokens_;  // [0, size_) are this line's
+  std::size_t size_ = 0;
+  std::size_t p_ = 0;
+};
 
 // Recovery by line: after an error, skip to the end of the line and let the
-// enclosing rules finish there. Never deletes a NEWLINE, so a mistake cannot
-// pull the next line into this statement.
+// enclosing rules finish there. Never deletes a NEWLINE; and as the parser
+// sees one line at a time, not even the failsafe below (which consumes a
+// token when two errors meet at one place) can pull the next line into this
+// statement.
 class LineErrorStrategy : public antlr4::DefaultErrorStrategy {
  public:
   explicit LineErrorStrategy(Session& session) : session_(session) {}
 
+  // Every line starts afresh (the parser is reset before each): the states
+  // of an earlier line's errors say nothing about this one.
+  void reset(antlr4::Parser* parser) override {
+    lastErrorStates.clear();
+    antlr4::DefaultErrorStrategy::reset(parser);
+  }
   void recover(antlr4::Parser* parser, std::exception_ptr) override {
     antlr4::TokenStream* input = parser->getTokenStream();
     auto index = static_cast<int>(input->index());
@@ -736,12 +819,11 @@ class SyntaxErrorListener : public antlr4::BaseErrorListener {
   Session& session_;
 };
 
-// The nearest enclosing context of type C within the statement.
+// The nearest enclosing context of type C within the line.
 template <typename C>
 C* Find(antlr4::RuleContext* ctx) {
   for (antlr4::RuleContext* c = ctx; c != nullptr; c = dynamic_cast<antlr4::RuleContext*>(c->parent)) {
     if (auto* found = dynamic_cast<C*>(c)) return found;
-    if (dynamic_cast<P::BlockContext*>(c) != nullptr || dynamic_cast<P::ProgramContext*>(c) != nullptr) break;
   }
   return nullptr;
 }
@@ -759,7 +841,7 @@ std::string NameRole(antlr4::RuleContext* ctx, const Token* previous) {
   if (Find<P::LocalDeclContext>(ctx)) return "a frame name";
   if (Find<P::PointDeclContext>(ctx) || Find<P::PalletDeclContext>(ctx)) return "a point name";
   if (Find<P::FunctionHeadContext>(ctx) || Find<P::CallStmtContext>(ctx)) return "a function name";
-  if (Find<P::VarDeclContext>(ctx) || Find<P::ForHeadContext>(ctx) || Find<P::ForStmtContext>(ctx)) {
+  if (Find<P::VarDeclContext>(ctx) || Find<P::ForHeadContext>(ctx) || Find<P::NextLineContext>(ctx)) {
     return "a variable name";
   }
   return "a name";
@@ -782,7 +864,6 @@ std::string FormHint(antlr4::RuleContext* ctx) {
     if (dynamic_cast<P::OffsetContext*>(c)) return "; write: + X(d)";
     if (dynamic_cast<P::ExitStmtContext*>(c)) return "; write: Exit Function";
     if (dynamic_cast<P::AssignmentContext*>(c)) return "; write: name = value";
-    if (dynamic_cast<P::BlockContext*>(c) || dynamic_cast<P::ProgramContext*>(c)) break;
   }
   return "";
 }
@@ -810,7 +891,9 @@ void Session::ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext
 
   if (auto* coords = Find<P::CoordsContext>(ctx)) {
     std::size_t numbers = 0;
-    for (auto* number : coords->signedNumber()) numbers += number->NUMBER() != nullptr ? 1 : 0;
+    for (P::SignedNumberContext* number : {coords->x, coords->y, coords->z, coords->u}) {
+      numbers += number != nullptr && number->value != nullptr ? 1 : 0;
+    }
     if (has(P::NUMBER) && type != P::RPAREN && !at_end) {
       Error(DiagKind::CoordsNotNumber, at, found_text);
       return;
@@ -882,142 +965,364 @@ void Session::ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext
   Error(DiagKind::ExpectedToken, at, list, after, found_text, FormHint(ctx));
 }
 
-// ------------------------------------------------------------------ step 3: the IR
+// ------------------------------------------------------------------ step 3: the IR of a line
 
-// The one visitor: parse tree -> IR. Each visit leaves the IR piece it
-// built (an empty one when the tree is incomplete after an error) in a
-// member slot and returns an empty antlrcpp::Any: boxing every piece in an
-// Any would cost a heap allocation and a dynamic_cast per node.
-class IrBuilder : public grammar::PlaceBaseVisitor {
+// Builds the IR of one parsed line from its rule's labelled elements. Each
+// piece is empty (null, nullopt) when the tree is incomplete after an error.
+class IrBuilder {
  public:
   explicit IrBuilder(Session& session) : s_(session) {}
 
-  // A block's statements plus its comment lines and blank-line marks, built
-  // line by line: Add() each statement in order, then Finish() at the line
-  // that closes the block (past the end of the file for the top level).
-  class BlockWalker {
-   public:
-    BlockWalker(IrBuilder& builder, std::uint32_t first) : b_(builder), line_(first) {}
-    void Add(antlr4::ParserRuleContext* item) {
-      std::uint32_t start = StartLine(item);
-      if (start < line_) return;  // a second statement on one line: an error
-      Until(start);
-      if (!b_.s_.LineHasError(start)) {
-        if (ir::StmtPtr stmt = b_.Stmt(item)) {
-          stmt->blank_line_before = blank_;
-          stmt->trailing_comment = b_.CommentOn(start);
-          block_.push_back(std::move(stmt));
-        }
-      }
-      blank_ = false;
-      line_ = std::max(start + 1, StopLine(item) + 1);
-    }
-    ir::Block Finish(std::uint32_t end) {
-      Until(end);
-      return std::move(block_);
-    }
-
-   private:
-    // The comment lines and blank lines before `end`.
-    void Until(std::uint32_t end) {
-      for (; line_ < end; ++line_) {
-        const Line* info = b_.s_.LineAt(line_);
-        if (info != nullptr && !info->had_code && info->comment != nullptr) {
-          auto stmt = std::make_unique<ir::Stmt>();
-          stmt->loc = b_.s_.Loc(info->comment);
-          stmt->length = b_.s_.Length(info->comment);
-          stmt->blank_line_before = blank_;
-          stmt->node = ir::Comment{b_.CommentOn(line_)};
-          block_.push_back(std::move(stmt));
-          blank_ = false;
-        } else {
-          blank_ = info != nullptr && !info->had_code && info->comment == nullptr;
-        }
-      }
-    }
-
-    IrBuilder& b_;
-    std::uint32_t line_;
-    bool blank_ = false;
-    ir::Block block_;
-  };
-
- private:
-  // ---- helpers
-  antlrcpp::Any Yield(ir::ExprPtr expr) {
-    expr_ = std::move(expr);
-    return {};
-  }
-  antlrcpp::Any Yield(ir::StmtPtr stmt) {
-    stmt_ = std::move(stmt);
-    return {};
-  }
-  antlrcpp::Any Yield(std::optional<ir::PointExpr> point) {
-    point_ = std::move(point);
-    return {};
-  }
-  // Visits ctx; its visit method leaves the result in a slot via Yield.
-  void Accept(antlr4::ParserRuleContext* ctx) {
-    antlrcpp::Any boxed = ctx->accept(this);
-    SMTCAL_CHECK(boxed.isNull(), "a visit returned its IR in the Any instead of through Yield");
-  }
-  ir::ExprPtr Expr(P::ExprContext* ctx) {
-    if (ctx == nullptr) return nullptr;
-    expr_.reset();
-    Accept(ctx);
-    return std::move(expr_);
-  }
-  std::optional<ir::PointExpr> Point(P::PointExprContext* ctx) {
-    if (ctx == nullptr) return std::nullopt;
-    point_.reset();
-    Accept(ctx);
-    std::optional<ir::PointExpr> point = std::move(point_);
-    point_.reset();
-    return point;
-  }
-  ir::StmtPtr Stmt(antlr4::ParserRuleContext* ctx) {
-    if (ctx == nullptr) return nullptr;
-    stmt_.reset();
-    Accept(ctx);
-    return std::move(stmt_);
-  }
-  static std::uint32_t StartLine(antlr4::ParserRuleContext* ctx) {
-    return static_cast<std::uint32_t>(ctx->getStart()->getLine());
-  }
-  static std::uint32_t StopLine(antlr4::ParserRuleContext* ctx) {
-    const Token* stop = ctx->getStop();
-    if (stop == nullptr) return StartLine(ctx);
-    return std::max(StartLine(ctx), static_cast<std::uint32_t>(stop->getLine()));
-  }
-  std::string Name(antlr4::tree::TerminalNode* node) const {
-    return node == nullptr ? std::string() : std::string(s_.Text(node->getSymbol()));
-  }
-  SourceLoc Loc(antlr4::tree::TerminalNode* node) const {
-    return node == nullptr ? SourceLoc{} : s_.Loc(node->getSymbol());
-  }
   // The text of the comment on `line`, without its ' and without spaces or
   // tabs at its end: they are invisible, and printing them back would end a
   // canonical line in whitespace. Spaces after the ' are kept as written.
   std::string CommentOn(std::size_t line) const {
-    const Line* info = s_.LineAt(line);
-    if (info == nullptr || info->comment == nullptr) return {};
-    std::string_view text = s_.Text(info->comment).substr(1);
+    const PlaceToken* comment = s_.CommentToken(line);
+    if (comment == nullptr) return {};
+    std::string_view text = s_.Text(*comment).substr(1);
     std::size_t end = text.find_last_not_of(" \t");
     return std::string(text.substr(0, end == std::string_view::npos ? 0 : end + 1));
   }
-  // A new statement located at ctx's first token.
-  ir::StmtPtr NewStmt(antlr4::ParserRuleContext* ctx) {
+  // A line that holds only a comment.
+  ir::StmtPtr CommentLine(std::size_t line) const {
+    const PlaceToken& comment = *s_.CommentToken(line);
+    auto stmt = std::make_unique<ir::Stmt>();
+    stmt->loc = s_.Loc(comment);
+    stmt->length = s_.Length(comment);
+    stmt->node = ir::Comment{CommentOn(line)};
+    return stmt;
+  }
+  // A block's closing line (Fend, Next, EndIf, EndCycle) ...
+  ir::BlockEnd End(const Token* closer) const {
+    return ir::BlockEnd{s_.Loc(closer), CommentOn(closer->getLine())};
+  }
+  // ... or a closer the pre-scan added at the position of the token `at`.
+  ir::BlockEnd End(const PlaceToken& at) const { return ir::BlockEnd{s_.Loc(at), CommentOn(at.line)}; }
+
+  // declaration : programDecl | unitsDecl | fixtureDecl | localDecl | pointDecl
+  //             | palletDecl | vacuumDecl | varDecl ;
+  ir::StmtPtr Declaration(P::DeclarationContext* ctx) {
+    if (ctx == nullptr) return nullptr;
+    if (ctx->programAlt != nullptr) return ProgramDecl(ctx->programAlt);
+    if (ctx->unitsAlt != nullptr) return UnitsDecl(ctx->unitsAlt);
+    if (ctx->fixtureAlt != nullptr) return FixtureDecl(ctx->fixtureAlt);
+    if (ctx->localAlt != nullptr) return LocalDecl(ctx->localAlt);
+    if (ctx->pointAlt != nullptr) return PointDecl(ctx->pointAlt);
+    if (ctx->palletAlt != nullptr) return PalletDecl(ctx->palletAlt);
+    if (ctx->vacuumAlt != nullptr) return VacuumDecl(ctx->vacuumAlt);
+    if (ctx->varDeclAlt != nullptr) return VarDecl(ctx->varDeclAlt);
+    return nullptr;
+  }
+  // statement : varDecl | assignment | motion | pickPlace | onOff | waitStmt
+  //           | callStmt | scanStmt | exitStmt ;
+  ir::StmtPtr Statement(P::StatementContext* ctx) {
+    if (ctx == nullptr) return nullptr;
+    if (ctx->pickPlaceAlt != nullptr) return PickPlace(ctx->pickPlaceAlt);
+    if (ctx->motionAlt != nullptr) return Motion(ctx->motionAlt);
+    if (ctx->assignmentAlt != nullptr) return Assignment(ctx->assignmentAlt);
+    if (ctx->varDeclAlt != nullptr) return VarDecl(ctx->varDeclAlt);
+    if (ctx->onOffAlt != nullptr) return OnOff(ctx->onOffAlt);
+    if (ctx->waitAlt != nullptr) return Wait(ctx->waitAlt);
+    if (ctx->callAlt != nullptr) return MakeStmt(ctx->callAlt, ir::Call{Name(ctx->callAlt->name), Loc(ctx->callAlt->name)});
+    if (ctx->scanAlt != nullptr) return MakeStmt(ctx->scanAlt, ir::Scan{Name(ctx->scanAlt->fixture), Loc(ctx->scanAlt->fixture)});
+    if (ctx->exitAlt != nullptr) return MakeStmt(ctx->exitAlt, ir::ExitFunction{});
+    return nullptr;
+  }
+
+  // ---- the first lines of blocks: the statement without its body
+  // functionHead : FUNCTION name=ID ('(' ')')? NEWLINE ;
+  ir::StmtPtr FunctionHead(P::FunctionHeadContext* ctx) {
+    return MakeStmt(ctx, ir::Function{Name(ctx->name), Loc(ctx->name), {}, {}});
+  }
+  // forHead : FOR var=ID '=' from=expr TO to=expr (STEP step=expr)? NEWLINE ;
+  ir::StmtPtr ForHead(P::ForHeadContext* ctx) {
+    if (ctx->from == nullptr || ctx->to == nullptr) return nullptr;
+    ir::For loop;
+    loop.var = Name(ctx->var);
+    loop.var_loc = Loc(ctx->var);
+    loop.from = Expr(ctx->from);
+    loop.to = Expr(ctx->to);
+    loop.step = Expr(ctx->step);
+    if (!loop.from || !loop.to) return nullptr;
+    return MakeStmt(ctx, std::move(loop));
+  }
+  // ifHead : IF condition=expr THEN NEWLINE ;   (the If with its first branch)
+  ir::StmtPtr IfHead(P::IfHeadContext* ctx) {
+    ir::IfBranch first;
+    first.loc = s_.Loc(ctx->getStart());
+    first.condition = Expr(ctx->condition);
+    if (!first.condition) return nullptr;
+    ir::If stmt;
+    stmt.branches.push_back(std::move(first));
+    return MakeStmt(ctx, std::move(stmt));
+  }
+  // elseIfHead : ELSEIF condition=expr THEN NEWLINE ;
+  std::optional<ir::IfBranch> ElseIfHead(P::ElseIfHeadContext* ctx) {
+    ir::IfBranch branch;
+    branch.loc = s_.Loc(ctx->getStart());
+    branch.condition = Expr(ctx->condition);
+    if (!branch.condition) return std::nullopt;
+    branch.comment = CommentOn(ctx->getStart()->getLine());
+    return branch;
+  }
+  // elseHead : ELSE NEWLINE ;
+  ir::IfBranch ElseHead(P::ElseHeadContext* ctx) {
+    ir::IfBranch branch;
+    branch.loc = s_.Loc(ctx->getStart());
+    branch.comment = CommentOn(ctx->getStart()->getLine());
+    return branch;
+  }
+  // cycleHead : CYCLE fixture=ID NEWLINE ;
+  ir::StmtPtr CycleHead(P::CycleHeadContext* ctx) {
+    return MakeStmt(ctx, ir::Cycle{Name(ctx->fixture), Loc(ctx->fixture), {}, {}});
+  }
+
+  std::string Name(const Token* token) const { return token == nullptr ? std::string() : std::string(s_.Text(token)); }
+  SourceLoc Loc(const Token* token) const { return token == nullptr ? SourceLoc{} : s_.Loc(token); }
+
+ private:
+  // A new statement located at the first token of `ctx`.
+  template <typename Node>
+  ir::StmtPtr MakeStmt(antlr4::ParserRuleContext* ctx, Node node) {
     auto stmt = std::make_unique<ir::Stmt>();
     stmt->loc = s_.Loc(ctx->getStart());
     stmt->length = s_.Length(ctx->getStart());
-    return stmt;
-  }
-  template <typename Node>
-  ir::StmtPtr MakeStmt(antlr4::ParserRuleContext* ctx, Node node) {
-    ir::StmtPtr stmt = NewStmt(ctx);
     stmt->node = std::move(node);
     return stmt;
   }
+
+  // A NUMBER token: value and whether it was written as a whole number.
+  ir::NumberLit Number(const Token* token) {
+    ir::NumberLit lit;
+    if (token == nullptr) return lit;
+    std::string_view text = s_.Text(token);
+    lit.is_integer = text.find_first_of(".eE") == std::string_view::npos;
+    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), lit.value);
+    (void)end;
+    if (ec == std::errc::result_out_of_range) {
+      s_.Error(DiagKind::NumberOutOfRange, s_.Range(token), std::string(text));
+      lit.value = 0;
+    }
+    return lit;
+  }
+  // A NUMBER that must be a whole number (pallet sizes, output numbers).
+  int WholeNumber(const Token* token, const char* what) {
+    if (token == nullptr) return 0;
+    ir::NumberLit lit = Number(token);
+    std::string text(s_.Text(token));
+    if (!lit.is_integer) {
+      s_.Error(DiagKind::WholeNumberRequired, s_.Range(token), std::string(what), text);
+      return 0;
+    }
+    if (lit.value > std::numeric_limits<int>::max()) {
+      s_.Error(DiagKind::WholeNumberTooLarge, s_.Range(token), std::string(what), std::numeric_limits<int>::max(),
+               text);
+      return 0;
+    }
+    return static_cast<int>(lit.value);
+  }
+  // coords : XY '(' x=signedNumber ',' y=signedNumber ',' z=signedNumber ',' u=signedNumber ')' ;
+  // signedNumber : sign=('-' | '+')? value=NUMBER ;
+  std::optional<ir::Coords> Coords(P::CoordsContext* ctx) {
+    if (ctx == nullptr) return std::nullopt;
+    const std::array<P::SignedNumberContext*, 4> numbers = {ctx->x, ctx->y, ctx->z, ctx->u};
+    for (P::SignedNumberContext* number : numbers) {
+      if (number == nullptr) return std::nullopt;
+    }
+    ir::Coords coords;
+    coords.loc = s_.Loc(ctx->getStart());
+    for (std::size_t i = 0; i < 4; ++i) {
+      double value = Number(numbers[i]->value).value;
+      bool negative = numbers[i]->sign != nullptr && numbers[i]->sign->getType() == P::MINUS;
+      coords.values[i] = negative ? -value : value;
+    }
+    return coords;
+  }
+
+  // ---- declarations
+  // programDecl : PROGRAM name=ID ;
+  ir::StmtPtr ProgramDecl(P::ProgramDeclContext* ctx) {
+    return MakeStmt(ctx, ir::ProgramDecl{Name(ctx->name), Loc(ctx->name)});
+  }
+  // unitsDecl : UNITS unit=ID ;
+  ir::StmtPtr UnitsDecl(P::UnitsDeclContext* ctx) {
+    return MakeStmt(ctx, ir::UnitsDecl{Name(ctx->unit), Loc(ctx->unit)});
+  }
+  // fixtureDecl : FIXTURE name=ID ;
+  ir::StmtPtr FixtureDecl(P::FixtureDeclContext* ctx) {
+    return MakeStmt(ctx, ir::FixtureDecl{Name(ctx->name), Loc(ctx->name)});
+  }
+  // localDecl : LOCAL name=ID '=' origin=coords (IN frame=ID)? ;
+  ir::StmtPtr LocalDecl(P::LocalDeclContext* ctx) {
+    std::optional<ir::Coords> coords = Coords(ctx->origin);
+    if (!coords) return nullptr;
+    ir::LocalDecl decl;
+    decl.name = Name(ctx->name);
+    decl.name_loc = Loc(ctx->name);
+    decl.origin = *coords;
+    decl.frame = Name(ctx->frame);
+    decl.frame_loc = Loc(ctx->frame);
+    return MakeStmt(ctx, std::move(decl));
+  }
+  // pointDecl : taught=TAUGHT? POINT name=ID '=' position=coords (frameKeyword=(IN | ON) frame=ID)? ;
+  ir::StmtPtr PointDecl(P::PointDeclContext* ctx) {
+    std::optional<ir::Coords> coords = Coords(ctx->position);
+    if (!coords) return nullptr;
+    ir::PointDecl decl;
+    decl.name = Name(ctx->name);
+    decl.name_loc = Loc(ctx->name);
+    decl.taught = ctx->taught != nullptr;
+    decl.coords = *coords;
+    decl.frame = Name(ctx->frame);
+    decl.frame_loc = Loc(ctx->frame);
+    // The IR keeps one frame for both forms, so the keyword must fit the point.
+    std::size_t keyword = ctx->frameKeyword != nullptr ? ctx->frameKeyword->getType() : 0;
+    if (decl.taught && keyword == P::IN) {
+      s_.Error(DiagKind::TaughtPointIn, s_.Range(ctx->frameKeyword), decl.frame);
+    }
+    if (!decl.taught && keyword == P::ON) {
+      s_.Error(DiagKind::ProgrammedPointOn, s_.Range(ctx->frameKeyword), decl.frame, decl.frame);
+    }
+    return MakeStmt(ctx, std::move(decl));
+  }
+  // palletDecl : PALLET number=NUMBER ',' corner1=ID ',' corner2=ID ',' corner3=ID
+  //              ',' columns=NUMBER ',' rows=NUMBER ;
+  ir::StmtPtr PalletDecl(P::PalletDeclContext* ctx) {
+    const std::array<Token*, 3> corners = {ctx->corner1, ctx->corner2, ctx->corner3};
+    if (ctx->number == nullptr || ctx->columns == nullptr || ctx->rows == nullptr) return nullptr;
+    for (const Token* corner : corners) {
+      if (corner == nullptr) return nullptr;
+    }
+    ir::PalletDecl decl;
+    decl.number = WholeNumber(ctx->number, "the pallet number");
+    decl.number_loc = Loc(ctx->number);
+    for (std::size_t i = 0; i < 3; ++i) {
+      decl.corners[i] = Name(corners[i]);
+      decl.corner_locs[i] = Loc(corners[i]);
+    }
+    decl.columns = WholeNumber(ctx->columns, "the number of pallet columns");
+    decl.columns_loc = Loc(ctx->columns);
+    decl.rows = WholeNumber(ctx->rows, "the number of pallet rows");
+    decl.rows_loc = Loc(ctx->rows);
+    return MakeStmt(ctx, std::move(decl));
+  }
+  // vacuumDecl : VACUUM output=NUMBER ;
+  ir::StmtPtr VacuumDecl(P::VacuumDeclContext* ctx) {
+    return MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->output, "the vacuum output"), Loc(ctx->output)});
+  }
+  // varDecl : type=(INTEGER | REAL) names+=ID (',' names+=ID)* ;
+  ir::StmtPtr VarDecl(P::VarDeclContext* ctx) {
+    ir::VarDecl decl;
+    decl.type = ctx->type != nullptr && ctx->type->getType() == P::REAL ? ir::VarType::Real : ir::VarType::Integer;
+    for (const Token* name : ctx->names) {
+      decl.names.push_back(Name(name));
+      decl.name_locs.push_back(Loc(name));
+    }
+    return MakeStmt(ctx, std::move(decl));
+  }
+
+  // ---- statements
+  // assignment : name=ID '=' value=expr ;
+  ir::StmtPtr Assignment(P::AssignmentContext* ctx) {
+    ir::ExprPtr value = Expr(ctx->value);
+    if (!value) return nullptr;
+    return MakeStmt(ctx, ir::Assign{Name(ctx->name), std::move(value)});
+  }
+  // motion : kind=(JUMP | GO | MOVE) target=pointExpr (limzKeyword=LIMZ limz=expr)? ;
+  ir::StmtPtr Motion(P::MotionContext* ctx) {
+    std::optional<ir::PointExpr> target = Point(ctx->target);
+    if (!target) return nullptr;
+    ir::Motion motion;
+    std::size_t kind = ctx->kind != nullptr ? ctx->kind->getType() : std::size_t{P::JUMP};
+    motion.kind = kind == P::GO ? ir::MotionKind::Go : kind == P::MOVE ? ir::MotionKind::Move : ir::MotionKind::Jump;
+    motion.target = std::move(*target);
+    motion.limz = Expr(ctx->limz);
+    motion.limz_loc = Loc(ctx->limzKeyword);
+    return MakeStmt(ctx, std::move(motion));
+  }
+  // pickPlace : kind=(PICK | PLACE) target=pointExpr (VACUUM vacuum=expr)? (LIMZ limz=expr)? ;
+  ir::StmtPtr PickPlace(P::PickPlaceContext* ctx) {
+    std::optional<ir::PointExpr> target = Point(ctx->target);
+    if (!target) return nullptr;
+    ir::PickPlace pick;
+    pick.kind = ctx->kind != nullptr && ctx->kind->getType() == P::PLACE ? ir::PickPlaceKind::Place
+                                                                          : ir::PickPlaceKind::Pick;
+    pick.target = std::move(*target);
+    pick.vacuum = Expr(ctx->vacuum);
+    pick.limz = Expr(ctx->limz);
+    return MakeStmt(ctx, std::move(pick));
+  }
+  // onOff : state=(ON | OFF) bit=expr ;
+  ir::StmtPtr OnOff(P::OnOffContext* ctx) {
+    ir::ExprPtr bit = Expr(ctx->bit);
+    if (!bit) return nullptr;
+    bool on = ctx->state != nullptr && ctx->state->getType() == P::ON;
+    return MakeStmt(ctx, ir::SetOutput{on, std::move(bit)});
+  }
+  // waitStmt : WAIT value=expr ;   Sw(n) = On|Off waits for an input, else seconds.
+  ir::StmtPtr Wait(P::WaitStmtContext* ctx) {
+    ir::ExprPtr expr = Expr(ctx->value);
+    if (!expr) return nullptr;
+    if (auto* eq = std::get_if<ir::BinaryExpr>(&expr->node); eq != nullptr && eq->op == ir::BinaryOp::Eq) {
+      auto* sw = std::get_if<ir::SwitchRead>(&eq->lhs->node);
+      auto* state = std::get_if<ir::OnOffLit>(&eq->rhs->node);
+      if (sw != nullptr && state != nullptr) return MakeStmt(ctx, ir::WaitSwitch{std::move(sw->bit), state->on});
+    }
+    return MakeStmt(ctx, ir::WaitTime{std::move(expr)});
+  }
+
+  // ---- points
+  // pointExpr : base=pointAtom (signs+=('+' | '-') offsets+=offset)* ;
+  // offset    : axis=ID '(' amount=expr ')' ;
+  std::optional<ir::PointExpr> Point(P::PointExprContext* ctx) {
+    if (ctx == nullptr || ctx->base == nullptr) return std::nullopt;
+    ir::PointExpr point;
+    point.loc = s_.Loc(ctx->getStart());
+    P::PointAtomContext* atom = ctx->base;
+    if (auto* named = dynamic_cast<P::NamedPointContext*>(atom)) {
+      point.base = ir::NamedPoint{Name(named->name), s_.Length(named->getStart())};
+    } else if (auto* literal = dynamic_cast<P::LiteralPointContext*>(atom)) {
+      std::optional<ir::Coords> coords = Coords(literal->position);
+      if (!coords) return std::nullopt;
+      point.base = *coords;
+    } else if (auto* pallet = dynamic_cast<P::PalletPointContext*>(atom)) {
+      ir::PalletPoint base;
+      base.number = Expr(pallet->number);
+      base.i = Expr(pallet->i);
+      base.j = Expr(pallet->j);
+      if (!base.number || !base.i) return std::nullopt;
+      point.base = std::move(base);
+    } else {
+      return std::nullopt;
+    }
+    // Each offset follows its sign token.
+    for (std::size_t k = 0; k < ctx->offsets.size(); ++k) {
+      P::OffsetContext* offset = ctx->offsets[k];
+      const Token* sign = k < ctx->signs.size() ? ctx->signs[k] : nullptr;
+      if (offset == nullptr || offset->axis == nullptr || sign == nullptr) return std::nullopt;
+      ir::PointOffset out;
+      out.loc = s_.Loc(sign);
+      out.negative = sign->getType() == P::MINUS;
+      std::string axis = Name(offset->axis);
+      if (axis == "x" || axis == "X") {
+        out.axis = ir::Axis::X;
+      } else if (axis == "y" || axis == "Y") {
+        out.axis = ir::Axis::Y;
+      } else if (axis == "z" || axis == "Z") {
+        out.axis = ir::Axis::Z;
+      } else if (axis == "u" || axis == "U") {
+        out.axis = ir::Axis::U;
+      } else {
+        s_.Error(DiagKind::UnknownOffsetAxis, s_.Range(offset->axis), axis);
+      }
+      out.amount = Expr(offset->amount);
+      if (!out.amount) return std::nullopt;
+      point.offsets.push_back(std::move(out));
+    }
+    return point;
+  }
+
+  // ---- expressions
   ir::ExprPtr NewExpr(antlr4::ParserRuleContext* ctx) {
     auto expr = std::make_unique<ir::Expr>();
     const Token* start = ctx->getStart();
@@ -1028,383 +1333,54 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
     expr->length = end >= begin ? static_cast<std::uint32_t>(end - begin + 1) : s_.Length(start);
     return expr;
   }
-  ir::BlockEnd End(antlr4::tree::TerminalNode* closer) const {
-    if (closer == nullptr) return {};
-    std::size_t line = closer->getSymbol()->getLine();
-    return ir::BlockEnd{Loc(closer), CommentOn(line)};
-  }
-  static std::uint32_t LineOf(antlr4::tree::TerminalNode* node, std::uint32_t fallback) {
-    return node == nullptr ? fallback : static_cast<std::uint32_t>(node->getSymbol()->getLine());
-  }
-
-  ir::Block Body(P::BlockContext* ctx, std::uint32_t first, std::uint32_t end) {
-    if (ctx == nullptr) return {};
-    BlockWalker walker(*this, first);
-    for (P::BlockLineContext* line : ctx->blockLine()) {
-      if (P::StatementContext* statement = line->statement()) walker.Add(statement);
-    }
-    return walker.Finish(end);
-  }
-
-  // A NUMBER token: value and whether it was written as a whole number.
-  ir::NumberLit Number(antlr4::tree::TerminalNode* node) {
-    ir::NumberLit lit;
-    if (node == nullptr) return lit;
-    std::string_view text = s_.Text(node->getSymbol());
-    lit.is_integer = text.find_first_of(".eE") == std::string_view::npos;
-    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), lit.value);
-    (void)end;
-    if (ec == std::errc::result_out_of_range) {
-      s_.Error(DiagKind::NumberOutOfRange, s_.Range(node->getSymbol()), std::string(text));
-      lit.value = 0;
-    }
-    return lit;
-  }
-  // A NUMBER that must be a whole number (pallet sizes, output numbers).
-  int WholeNumber(antlr4::tree::TerminalNode* node, const char* what) {
-    if (node == nullptr) return 0;
-    ir::NumberLit lit = Number(node);
-    std::string text(s_.Text(node->getSymbol()));
-    if (!lit.is_integer) {
-      s_.Error(DiagKind::WholeNumberRequired, s_.Range(node->getSymbol()), std::string(what), text);
-      return 0;
-    }
-    if (lit.value > std::numeric_limits<int>::max()) {
-      s_.Error(DiagKind::WholeNumberTooLarge, s_.Range(node->getSymbol()), std::string(what),
-               std::numeric_limits<int>::max(), text);
-      return 0;
-    }
-    return static_cast<int>(lit.value);
-  }
-  std::optional<ir::Coords> Coords(P::CoordsContext* ctx) {
-    if (ctx == nullptr || ctx->signedNumber().size() != 4) return std::nullopt;
-    ir::Coords coords;
-    coords.loc = s_.Loc(ctx->getStart());
-    for (std::size_t i = 0; i < 4; ++i) {
-      P::SignedNumberContext* number = ctx->signedNumber(i);
-      double value = Number(number->NUMBER()).value;
-      coords.values[i] = number->MINUS() != nullptr ? -value : value;
-    }
-    return coords;
-  }
-
-  // ---- top level
-  // programDecl : PROGRAM ID ;
-  antlrcpp::Any visitProgramDecl(P::ProgramDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::ProgramDecl{Name(ctx->ID()), Loc(ctx->ID())}));
-  }
-  // unitsDecl : UNITS ID ;
-  antlrcpp::Any visitUnitsDecl(P::UnitsDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::UnitsDecl{Name(ctx->ID()), Loc(ctx->ID())}));
-  }
-  // fixtureDecl : FIXTURE ID ;
-  antlrcpp::Any visitFixtureDecl(P::FixtureDeclContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::FixtureDecl{Name(ctx->ID()), Loc(ctx->ID())}));
-  }
-  // localDecl : LOCAL ID '=' coords (IN ID)? ;
-  antlrcpp::Any visitLocalDecl(P::LocalDeclContext* ctx) override {
-    std::optional<ir::Coords> coords = Coords(ctx->coords());
-    if (!coords) return Yield(ir::StmtPtr());
-    ir::LocalDecl decl;
-    decl.name = Name(ctx->ID(0));
-    decl.name_loc = Loc(ctx->ID(0));
-    decl.origin = *coords;
-    decl.frame = Name(ctx->ID(1));
-    decl.frame_loc = Loc(ctx->ID(1));
-    return Yield(MakeStmt(ctx, std::move(decl)));
-  }
-  // pointDecl : TAUGHT? POINT ID '=' coords ((IN | ON) ID)? ;
-  antlrcpp::Any visitPointDecl(P::PointDeclContext* ctx) override {
-    std::optional<ir::Coords> coords = Coords(ctx->coords());
-    if (!coords) return Yield(ir::StmtPtr());
-    ir::PointDecl decl;
-    decl.name = Name(ctx->ID(0));
-    decl.name_loc = Loc(ctx->ID(0));
-    decl.taught = ctx->TAUGHT() != nullptr;
-    decl.coords = *coords;
-    decl.frame = Name(ctx->ID(1));
-    decl.frame_loc = Loc(ctx->ID(1));
-    // The IR keeps one frame for both forms, so the keyword must fit the point.
-    if (decl.taught && ctx->IN() != nullptr) {
-      s_.Error(DiagKind::TaughtPointIn, s_.Range(ctx->IN()->getSymbol()), decl.frame);
-    }
-    if (!decl.taught && ctx->ON() != nullptr) {
-      s_.Error(DiagKind::ProgrammedPointOn, s_.Range(ctx->ON()->getSymbol()), decl.frame, decl.frame);
-    }
-    return Yield(MakeStmt(ctx, std::move(decl)));
-  }
-  // palletDecl : PALLET NUMBER ',' ID ',' ID ',' ID ',' NUMBER ',' NUMBER ;
-  antlrcpp::Any visitPalletDecl(P::PalletDeclContext* ctx) override {
-    if (ctx->NUMBER().size() != 3 || ctx->ID().size() != 3) return Yield(ir::StmtPtr());
-    ir::PalletDecl decl;
-    decl.number = WholeNumber(ctx->NUMBER(0), "the pallet number");
-    decl.number_loc = Loc(ctx->NUMBER(0));
-    for (std::size_t i = 0; i < 3; ++i) {
-      decl.corners[i] = Name(ctx->ID(i));
-      decl.corner_locs[i] = Loc(ctx->ID(i));
-    }
-    decl.columns = WholeNumber(ctx->NUMBER(1), "the number of pallet columns");
-    decl.columns_loc = Loc(ctx->NUMBER(1));
-    decl.rows = WholeNumber(ctx->NUMBER(2), "the number of pallet rows");
-    decl.rows_loc = Loc(ctx->NUMBER(2));
-    return Yield(MakeStmt(ctx, std::move(decl)));
-  }
-  // vacuumDecl : VACUUM NUMBER ;
-  antlrcpp::Any visitVacuumDecl(P::VacuumDeclContext* ctx) override {
-    return Yield(
-        MakeStmt(ctx, ir::VacuumDecl{WholeNumber(ctx->NUMBER(), "the vacuum output"), Loc(ctx->NUMBER())}));
-  }
-  // varDecl : (INTEGER | REAL) ID (',' ID)* ;
-  antlrcpp::Any visitVarDecl(P::VarDeclContext* ctx) override {
-    ir::VarDecl decl;
-    decl.type = ctx->REAL() != nullptr ? ir::VarType::Real : ir::VarType::Integer;
-    for (auto* id : ctx->ID()) {
-      decl.names.push_back(Name(id));
-      decl.name_locs.push_back(Loc(id));
-    }
-    return Yield(MakeStmt(ctx, std::move(decl)));
-  }
-  // functionDecl : functionHead block FEND ;
-  // functionHead : FUNCTION ID ('(' ')')? NEWLINE ;
-  antlrcpp::Any visitFunctionDecl(P::FunctionDeclContext* ctx) override {
-    if (ctx->functionHead() == nullptr) return Yield(ir::StmtPtr());
-    ir::Function function;
-    function.name = Name(ctx->functionHead()->ID());
-    function.name_loc = Loc(ctx->functionHead()->ID());
-    std::uint32_t head = StartLine(ctx);
-    function.body = Body(ctx->block(), head + 1, LineOf(ctx->FEND(), StopLine(ctx) + 1));
-    function.end = End(ctx->FEND());
-    return Yield(MakeStmt(ctx, std::move(function)));
-  }
-  // topLevel : programDecl | unitsDecl | ... ;
-  antlrcpp::Any visitTopLevel(P::TopLevelContext* ctx) override {
-    if (!ctx->children.empty()) ctx->children.front()->accept(this);
-    return {};
-  }
-
-  // ---- statements
-  // statement : varDecl | assignment | motion | ... ;
-  antlrcpp::Any visitStatement(P::StatementContext* ctx) override {
-    if (!ctx->children.empty()) ctx->children.front()->accept(this);
-    return {};
-  }
-  // assignment : ID '=' expr ;
-  antlrcpp::Any visitAssignment(P::AssignmentContext* ctx) override {
-    ir::ExprPtr value = Expr(ctx->expr());
-    if (!value) return Yield(ir::StmtPtr());
-    return Yield(MakeStmt(ctx, ir::Assign{Name(ctx->ID()), std::move(value)}));
-  }
-  // motion : (JUMP | GO | MOVE) pointExpr (LIMZ expr)? ;
-  antlrcpp::Any visitMotion(P::MotionContext* ctx) override {
-    std::optional<ir::PointExpr> target = Point(ctx->pointExpr());
-    if (!target) return Yield(ir::StmtPtr());
-    ir::Motion motion;
-    motion.kind = ctx->GO() != nullptr     ? ir::MotionKind::Go
-                  : ctx->MOVE() != nullptr ? ir::MotionKind::Move
-                                           : ir::MotionKind::Jump;
-    motion.target = std::move(*target);
-    motion.limz = Expr(ctx->expr());
-    motion.limz_loc = Loc(ctx->LIMZ());
-    return Yield(MakeStmt(ctx, std::move(motion)));
-  }
-  // pickPlace : (PICK | PLACE) pointExpr (VACUUM expr)? (LIMZ expr)? ;
-  antlrcpp::Any visitPickPlace(P::PickPlaceContext* ctx) override {
-    std::optional<ir::PointExpr> target = Point(ctx->pointExpr());
-    if (!target) return Yield(ir::StmtPtr());
-    ir::PickPlace pick;
-    pick.kind = ctx->PLACE() != nullptr ? ir::PickPlaceKind::Place : ir::PickPlaceKind::Pick;
-    pick.target = std::move(*target);
-    // Which expr is which: the keyword before it says.
-    std::size_t keyword = 0;
-    for (antlr4::tree::ParseTree* child : ctx->children) {
-      if (auto* terminal = dynamic_cast<antlr4::tree::TerminalNode*>(child)) {
-        keyword = terminal->getSymbol()->getType();
-      } else if (auto* expr = dynamic_cast<P::ExprContext*>(child)) {
-        (keyword == P::VACUUM ? pick.vacuum : pick.limz) = Expr(expr);
-      }
-    }
-    return Yield(MakeStmt(ctx, std::move(pick)));
-  }
-  // onOff : (ON | OFF) expr ;
-  antlrcpp::Any visitOnOff(P::OnOffContext* ctx) override {
-    ir::ExprPtr bit = Expr(ctx->expr());
-    if (!bit) return Yield(ir::StmtPtr());
-    return Yield(MakeStmt(ctx, ir::SetOutput{ctx->ON() != nullptr, std::move(bit)}));
-  }
-  // waitStmt : WAIT expr ;   Sw(n) = On|Off waits for an input, else seconds.
-  antlrcpp::Any visitWaitStmt(P::WaitStmtContext* ctx) override {
-    ir::ExprPtr expr = Expr(ctx->expr());
-    if (!expr) return Yield(ir::StmtPtr());
-    if (auto* eq = std::get_if<ir::BinaryExpr>(&expr->node); eq != nullptr && eq->op == ir::BinaryOp::Eq) {
-      auto* sw = std::get_if<ir::SwitchRead>(&eq->lhs->node);
-      auto* state = std::get_if<ir::OnOffLit>(&eq->rhs->node);
-      if (sw != nullptr && state != nullptr) {
-        return Yield(MakeStmt(ctx, ir::WaitSwitch{std::move(sw->bit), state->on}));
-      }
-    }
-    return Yield(MakeStmt(ctx, ir::WaitTime{std::move(expr)}));
-  }
-  // forStmt : forHead block NEXT ID? ;
-  // forHead : FOR ID '=' expr TO expr (STEP expr)? NEWLINE ;
-  antlrcpp::Any visitForStmt(P::ForStmtContext* ctx) override {
-    P::ForHeadContext* head = ctx->forHead();
-    if (head == nullptr || head->expr().size() < 2) return Yield(ir::StmtPtr());
-    ir::For loop;
-    loop.var = Name(head->ID());
-    loop.var_loc = Loc(head->ID());
-    loop.from = Expr(head->expr(0));
-    loop.to = Expr(head->expr(1));
-    loop.step = Expr(head->expr(2));
-    if (!loop.from || !loop.to) return Yield(ir::StmtPtr());
-    loop.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->NEXT(), StopLine(ctx) + 1));
-    loop.end = End(ctx->NEXT());
-    loop.next_var = Name(ctx->ID());
-    loop.next_var_loc = Loc(ctx->ID());
-    return Yield(MakeStmt(ctx, std::move(loop)));
-  }
-  // ifStmt     : ifHead block elseIfPart* elsePart? ENDIF ;
-  // elseIfPart : elseIfHead block ;       elsePart : elseHead block ;
-  antlrcpp::Any visitIfStmt(P::IfStmtContext* ctx) override {
-    P::IfHeadContext* head = ctx->ifHead();
-    if (head == nullptr) return Yield(ir::StmtPtr());
-    // The line where each branch starts, then the EndIf line.
-    std::vector<std::uint32_t> starts = {StartLine(ctx)};
-    for (auto* part : ctx->elseIfPart()) starts.push_back(StartLine(part));
-    if (ctx->elsePart() != nullptr) starts.push_back(StartLine(ctx->elsePart()));
-    starts.push_back(LineOf(ctx->ENDIF(), StopLine(ctx) + 1));
-
-    ir::If stmt;
-    ir::IfBranch first;
-    first.loc = Loc(head->IF());
-    first.condition = Expr(head->expr());
-    if (!first.condition) return Yield(ir::StmtPtr());
-    first.body = Body(ctx->block(), starts[0] + 1, starts[1]);
-    stmt.branches.push_back(std::move(first));
-    std::size_t k = 1;
-    for (auto* part : ctx->elseIfPart()) {
-      ir::IfBranch branch;
-      P::ElseIfHeadContext* part_head = part->elseIfHead();
-      if (part_head == nullptr || s_.LineHasError(starts[k])) return Yield(ir::StmtPtr());
-      branch.loc = Loc(part_head->ELSEIF());
-      branch.condition = Expr(part_head->expr());
-      if (!branch.condition) return Yield(ir::StmtPtr());
-      branch.body = Body(part->block(), starts[k] + 1, starts[k + 1]);
-      branch.comment = CommentOn(starts[k]);
-      stmt.branches.push_back(std::move(branch));
-      ++k;
-    }
-    if (P::ElsePartContext* part = ctx->elsePart()) {
-      ir::IfBranch branch;
-      if (part->elseHead() == nullptr) return Yield(ir::StmtPtr());
-      branch.loc = Loc(part->elseHead()->ELSE());
-      branch.body = Body(part->block(), starts[k] + 1, starts[k + 1]);
-      branch.comment = CommentOn(starts[k]);
-      stmt.branches.push_back(std::move(branch));
-    }
-    stmt.end = End(ctx->ENDIF());
-    return Yield(MakeStmt(ctx, std::move(stmt)));
-  }
-  // callStmt : CALL ID ('(' ')')? ;
-  antlrcpp::Any visitCallStmt(P::CallStmtContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::Call{Name(ctx->ID()), Loc(ctx->ID())}));
-  }
-  // cycleStmt : cycleHead block ENDCYCLE ;    cycleHead : CYCLE ID NEWLINE ;
-  antlrcpp::Any visitCycleStmt(P::CycleStmtContext* ctx) override {
-    if (ctx->cycleHead() == nullptr) return Yield(ir::StmtPtr());
-    ir::Cycle cycle;
-    cycle.fixture = Name(ctx->cycleHead()->ID());
-    cycle.fixture_loc = Loc(ctx->cycleHead()->ID());
-    cycle.body = Body(ctx->block(), StartLine(ctx) + 1, LineOf(ctx->ENDCYCLE(), StopLine(ctx) + 1));
-    cycle.end = End(ctx->ENDCYCLE());
-    return Yield(MakeStmt(ctx, std::move(cycle)));
-  }
-  // scanStmt : SCAN ID ;
-  antlrcpp::Any visitScanStmt(P::ScanStmtContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::Scan{Name(ctx->ID()), Loc(ctx->ID())}));
-  }
-  // exitStmt : EXIT FUNCTION ;
-  antlrcpp::Any visitExitStmt(P::ExitStmtContext* ctx) override {
-    return Yield(MakeStmt(ctx, ir::ExitFunction{}));
-  }
-
-  // ---- points
-  // pointExpr : pointAtom (('+' | '-') offset)* ;
-  // offset    : ID '(' expr ')' ;
-  antlrcpp::Any visitPointExpr(P::PointExprContext* ctx) override {
-    std::optional<ir::PointExpr> point;
-    if (ctx->pointAtom() == nullptr) return Yield(std::move(point));
-    point.emplace();
-    point->loc = s_.Loc(ctx->getStart());
-    P::PointAtomContext* atom = ctx->pointAtom();
-    if (auto* named = dynamic_cast<P::NamedPointContext*>(atom)) {
-      point->base = ir::NamedPoint{Name(named->ID()), s_.Length(named->getStart())};
-    } else if (auto* literal = dynamic_cast<P::LiteralPointContext*>(atom)) {
-      std::optional<ir::Coords> coords = Coords(literal->coords());
-      if (!coords) return Yield(std::optional<ir::PointExpr>());
-      point->base = *coords;
-    } else if (auto* pallet = dynamic_cast<P::PalletPointContext*>(atom)) {
-      ir::PalletPoint base;
-      base.number = Expr(pallet->expr(0));
-      base.i = Expr(pallet->expr(1));
-      base.j = Expr(pallet->expr(2));
-      if (!base.number || !base.i) return Yield(std::optional<ir::PointExpr>());
-      point->base = std::move(base);
-    } else {
-      return Yield(std::optional<ir::PointExpr>());
-    }
-    // Each offset follows its sign token.
-    bool negative = false;
-    const Token* sign = nullptr;
-    for (antlr4::tree::ParseTree* child : ctx->children) {
-      if (auto* terminal = dynamic_cast<antlr4::tree::TerminalNode*>(child)) {
-        sign = terminal->getSymbol();
-        negative = sign->getType() == P::MINUS;
-      } else if (auto* offset = dynamic_cast<P::OffsetContext*>(child)) {
-        if (offset->ID() == nullptr || sign == nullptr) return Yield(std::optional<ir::PointExpr>());
-        ir::PointOffset out;
-        out.loc = s_.Loc(sign);
-        out.negative = negative;
-        std::string axis = Name(offset->ID());
-        if (axis == "x" || axis == "X") {
-          out.axis = ir::Axis::X;
-        } else if (axis == "y" || axis == "Y") {
-          out.axis = ir::Axis::Y;
-        } else if (axis == "z" || axis == "Z") {
-          out.axis = ir::Axis::Z;
-        } else if (axis == "u" || axis == "U") {
-          out.axis = ir::Axis::U;
-        } else {
-          s_.Error(DiagKind::UnknownOffsetAxis, s_.Range(offset->ID()->getSymbol()), axis);
-        }
-        out.amount = Expr(offset->expr());
-        if (!out.amount) return Yield(std::optional<ir::PointExpr>());
-        point->offsets.push_back(std::move(out));
-      }
-    }
-    return Yield(std::move(point));
-  }
-
-  // ---- expressions
-  // expr : '(' expr ')'
-  antlrcpp::Any visitParenExpr(P::ParenExprContext* ctx) override { return Yield(Expr(ctx->expr())); }
-  //      | op=('-' | '+' | NOT) expr
-  antlrcpp::Any visitUnaryExpr(P::UnaryExprContext* ctx) override {
-    ir::ExprPtr operand = Expr(ctx->expr());
-    if (!operand || ctx->op == nullptr) return Yield(ir::ExprPtr());
+  template <typename Node>
+  ir::ExprPtr MakeExpr(antlr4::ParserRuleContext* ctx, Node node) {
     ir::ExprPtr expr = NewExpr(ctx);
-    std::size_t op = ctx->op->getType();
-    expr->node = ir::UnaryExpr{op == P::MINUS ? ir::UnaryOp::Negate
-                               : op == P::PLUS ? ir::UnaryOp::Plus
-                                               : ir::UnaryOp::Not,
-                               std::move(operand)};
-    return Yield(std::move(expr));
+    expr->node = std::move(node);
+    return expr;
   }
-  //      | expr op=(...) expr
-  antlrcpp::Any visitBinaryExpr(P::BinaryExprContext* ctx) override {
-    if (ctx->expr().size() != 2 || ctx->op == nullptr) return Yield(ir::ExprPtr());
-    ir::ExprPtr lhs = Expr(ctx->expr(0));
-    ir::ExprPtr rhs = Expr(ctx->expr(1));
-    if (!lhs || !rhs) return Yield(ir::ExprPtr());
+
+  // expr : ... (one labelled alternative per kind of context).
+  ir::ExprPtr Expr(P::ExprContext* ctx) {
+    if (ctx == nullptr) return nullptr;
+    //      | value=NUMBER
+    if (auto* number = dynamic_cast<P::NumberExprContext*>(ctx)) return MakeExpr(number, Number(number->value));
+    //      | name=ID
+    if (auto* variable = dynamic_cast<P::VariableExprContext*>(ctx)) {
+      return MakeExpr(variable, ir::VariableRef{Name(variable->name)});
+    }
+    //      | lhs=expr op=(...) rhs=expr
+    if (auto* binary = dynamic_cast<P::BinaryExprContext*>(ctx)) return Binary(binary);
+    //      | op=('-' | '+' | NOT) operand=expr
+    if (auto* unary = dynamic_cast<P::UnaryExprContext*>(ctx)) {
+      ir::ExprPtr operand = Expr(unary->operand);
+      if (!operand || unary->op == nullptr) return nullptr;
+      std::size_t op = unary->op->getType();
+      return MakeExpr(unary, ir::UnaryExpr{op == P::MINUS  ? ir::UnaryOp::Negate
+                                           : op == P::PLUS ? ir::UnaryOp::Plus
+                                                           : ir::UnaryOp::Not,
+                                           std::move(operand)});
+    }
+    // expr : '(' inner=expr ')'  (the parentheses leave no node)
+    if (auto* paren = dynamic_cast<P::ParenExprContext*>(ctx)) return Expr(paren->inner);
+    //      | SW '(' bit=expr ')'
+    if (auto* sw = dynamic_cast<P::SwitchExprContext*>(ctx)) {
+      ir::ExprPtr bit = Expr(sw->bit);
+      if (!bit) return nullptr;
+      return MakeExpr(sw, ir::SwitchRead{std::move(bit)});
+    }
+    //      | value=(ON | OFF)
+    if (auto* on_off = dynamic_cast<P::OnOffExprContext*>(ctx)) {
+      return MakeExpr(on_off, ir::OnOffLit{on_off->value != nullptr && on_off->value->getType() == P::ON});
+    }
+    return nullptr;
+  }
+
+  ir::ExprPtr Binary(P::BinaryExprContext* ctx) {
+    if (ctx->lhs == nullptr || ctx->rhs == nullptr || ctx->op == nullptr) return nullptr;
+    ir::ExprPtr lhs = Expr(ctx->lhs);
+    ir::ExprPtr rhs = Expr(ctx->rhs);
+    if (!lhs || !rhs) return nullptr;
     ir::BinaryOp op;
     switch (ctx->op->getType()) {
       case P::PLUS: op = ir::BinaryOp::Add; break;
@@ -1421,74 +1397,293 @@ class IrBuilder : public grammar::PlaceBaseVisitor {
       case P::AND: op = ir::BinaryOp::And; break;
       case P::OR: op = ir::BinaryOp::Or; break;
       case P::XOR: op = ir::BinaryOp::Xor; break;
-      default: return Yield(ir::ExprPtr());
+      default: return nullptr;
     }
-    ir::ExprPtr expr = NewExpr(ctx);
-    expr->node = ir::BinaryExpr{op, std::move(lhs), std::move(rhs)};
-    return Yield(std::move(expr));
-  }
-  //      | SW '(' expr ')'
-  antlrcpp::Any visitSwitchExpr(P::SwitchExprContext* ctx) override {
-    ir::ExprPtr bit = Expr(ctx->expr());
-    if (!bit) return Yield(ir::ExprPtr());
-    ir::ExprPtr expr = NewExpr(ctx);
-    expr->node = ir::SwitchRead{std::move(bit)};
-    return Yield(std::move(expr));
-  }
-  //      | (ON | OFF)
-  antlrcpp::Any visitOnOffExpr(P::OnOffExprContext* ctx) override {
-    ir::ExprPtr expr = NewExpr(ctx);
-    expr->node = ir::OnOffLit{ctx->ON() != nullptr};
-    return Yield(std::move(expr));
-  }
-  //      | NUMBER
-  antlrcpp::Any visitNumberExpr(P::NumberExprContext* ctx) override {
-    ir::ExprPtr expr = NewExpr(ctx);
-    expr->node = Number(ctx->NUMBER());
-    return Yield(std::move(expr));
-  }
-  //      | ID
-  antlrcpp::Any visitVariableExpr(P::VariableExprContext* ctx) override {
-    ir::ExprPtr expr = NewExpr(ctx);
-    expr->node = ir::VariableRef{Name(ctx->ID())};
-    return Yield(std::move(expr));
+    return MakeExpr(ctx, ir::BinaryExpr{op, std::move(lhs), std::move(rhs)});
   }
 
   Session& s_;
-  ir::ExprPtr expr_;
-  ir::StmtPtr stmt_;
-  std::optional<ir::PointExpr> point_;
+};
+
+// ------------------------------------------------------------------ step 3: the blocks
+
+// A block's statements plus its comment lines and blank-line marks, built
+// line by line: Begin() and End() each statement in order, then Finish() at
+// the line that closes the block (past the end of the file for the top level).
+class BlockWalker {
+ public:
+  BlockWalker(const Session& session, const IrBuilder& ir, std::uint32_t first)
+      : s_(&session), ir_(&ir), line_(first) {}
+
+  // Whether a statement starting on `start` joins the block (not when the
+  // block already holds a statement ending on that line: a block the
+  // pre-scan closed there). Adds the comment and blank lines before it.
+  bool Begin(std::uint32_t start) {
+    if (start < line_) return false;
+    Until(start);
+    return true;
+  }
+  // The statement that began on `start` and ends on `stop` (null: dropped).
+  void End(std::uint32_t start, std::uint32_t stop, ir::StmtPtr stmt) {
+    if (stmt) {
+      stmt->blank_line_before = blank_;
+      stmt->trailing_comment = ir_->CommentOn(start);
+      block_.push_back(std::move(stmt));
+    }
+    blank_ = false;
+    line_ = std::max(start, stop) + 1;
+  }
+  ir::Block Finish(std::uint32_t end) {
+    Until(end);
+    return std::move(block_);
+  }
+
+ private:
+  // The comment lines and blank lines before `end`.
+  void Until(std::uint32_t end) {
+    for (; line_ < end; ++line_) {
+      const Line* info = s_->LineAt(line_);
+      if (info != nullptr && !info->had_code && info->comment >= 0) {
+        ir::StmtPtr stmt = ir_->CommentLine(line_);
+        stmt->blank_line_before = blank_;
+        block_.push_back(std::move(stmt));
+        blank_ = false;
+      } else {
+        blank_ = info != nullptr && !info->had_code && info->comment < 0;
+      }
+    }
+  }
+
+  const Session* s_;
+  const IrBuilder* ir_;
+  std::uint32_t line_;
+  bool blank_ = false;
+  ir::Block block_;
+};
+
+// The open blocks, innermost last, each with its statement so far: the IR
+// of its first line (and of an If's ElseIf and Else lines); the bodies come
+// when the block closes. A block whose first line has an error is dropped,
+// as is an If with an ElseIf line that has one; their lines are still
+// parsed (for their errors) but not built.
+class BlockBuilder {
+ public:
+  BlockBuilder(const Session& session, const IrBuilder& ir) : s_(session), ir_(ir) {
+    frames_.push_back(Frame{0, BlockWalker(session, ir, 1), false, true, 0, nullptr});
+  }
+
+  // A line that is one statement (or declaration); build(ctx) makes its IR.
+  template <typename Build>
+  void Statement(std::uint32_t line, Build&& build) {
+    Frame& frame = frames_.back();
+    if (!frame.keep || !frame.body.Begin(line)) return;
+    frame.body.End(line, line, s_.LineHasError(line) ? nullptr : build());
+  }
+
+  // The first line of a block; head() makes its statement without the body
+  // (null drops the block).
+  template <typename Head>
+  void Open(std::size_t type, std::uint32_t line, Head&& head) {
+    Frame& outer = frames_.back();
+    Frame frame{type, BlockWalker(s_, ir_, line + 1), false, false, line, nullptr};
+    frame.joined = outer.keep && outer.body.Begin(line);
+    if (frame.joined && !s_.LineHasError(line)) frame.stmt = head();
+    frame.keep = frame.stmt != nullptr;
+    frames_.push_back(std::move(frame));
+  }
+
+  // An ElseIf line of the innermost If; branch() makes its branch (nullopt
+  // drops the If).
+  template <typename Branch>
+  void ElseIf(std::uint32_t line, Branch&& branch) {
+    Frame& frame = Innermost(P::IF);
+    if (!frame.keep) return;
+    ir::If& stmt = std::get<ir::If>(frame.stmt->node);
+    stmt.branches.back().body = frame.body.Finish(line);
+    std::optional<ir::IfBranch> next;
+    if (!s_.LineHasError(line)) next = branch();
+    if (!next) return Drop(frame);
+    stmt.branches.push_back(std::move(*next));
+    frame.body = BlockWalker(s_, ir_, line + 1);
+  }
+  // The Else line of the innermost If.
+  void Else(std::uint32_t line, ir::IfBranch branch) {
+    Frame& frame = Innermost(P::IF);
+    if (!frame.keep) return;
+    ir::If& stmt = std::get<ir::If>(frame.stmt->node);
+    stmt.branches.back().body = frame.body.Finish(line);
+    stmt.branches.push_back(std::move(branch));
+    frame.body = BlockWalker(s_, ir_, line + 1);
+  }
+  bool AtTopLevel() const { return frames_.size() == 1; }
+
+  // Closes the innermost block (of type `type`) on line `line`: its Fend,
+  // Next, EndIf or EndCycle there, or one the pre-scan added.
+  void Close(std::size_t type, std::uint32_t line, ir::BlockEnd end, std::string next_var = {},
+             SourceLoc next_var_loc = {}) {
+    Frame frame = std::move(Innermost(type));
+    frames_.pop_back();
+    if (frame.keep) {
+      ir::Block body = frame.body.Finish(line);
+      std::visit(
+          [&](auto& node) {
+            using Node = std::decay_t<decltype(node)>;
+            if constexpr (std::is_same_v<Node, ir::Function> || std::is_same_v<Node, ir::Cycle>) {
+              node.body = std::move(body);
+              node.end = std::move(end);
+            } else if constexpr (std::is_same_v<Node, ir::For>) {
+              node.body = std::move(body);
+              node.end = std::move(end);
+              node.next_var = std::move(next_var);
+              node.next_var_loc = next_var_loc;
+            } else if constexpr (std::is_same_v<Node, ir::If>) {
+              node.branches.back().body = std::move(body);
+              node.end = std::move(end);
+            }
+          },
+          frame.stmt->node);
+    }
+    if (frame.joined) frames_.back().body.End(frame.start, line, std::move(frame.stmt));
+  }
+
+  ir::Block Finish(std::uint32_t end) {
+    SMTCAL_CHECK(frames_.size() == 1, "the pre-scan closes every block");
+    return frames_.back().body.Finish(end);
+  }
+
+ private:
+  struct Frame {
+    std::size_t type;     // FUNCTION, FOR, IF or CYCLE; 0 for the top level
+    BlockWalker body;     // the block (an If's current branch)
+    bool joined = false;  // its statement has its place in the block around it
+    bool keep = true;     // its lines are built (false: the block is dropped)
+    std::uint32_t start = 0;  // its first line
+    ir::StmtPtr stmt;     // the statement, while it is kept
+  };
+
+  Frame& Innermost(std::size_t type) {
+    SMTCAL_CHECK(frames_.size() > 1 && frames_.back().type == type, "the pre-scan keeps the blocks well nested");
+    return frames_.back();
+  }
+  static void Drop(Frame& frame) {
+    frame.keep = false;
+    frame.stmt.reset();
+  }
+
+  const Session& s_;
+  const IrBuilder& ir_;
+  std::vector<Frame> frames_;
 };
 
 // ------------------------------------------------------------------ driver
 
+class LineParser {
+ public:
+  explicit LineParser(Session& session, antlr4::ANTLRErrorListener& listener,
+                      std::shared_ptr<antlr4::ANTLRErrorStrategy> strategy)
+      : tokens_(session), parser_(&tokens_) {
+    parser_.removeErrorListeners();
+    parser_.addErrorListener(&listener);
+    parser_.setErrorHandler(std::move(strategy));
+    // The IR is built from the rules' labelled elements (and contexts know
+    // their parents without it): no child lists, no node per token.
+    parser_.setBuildParseTree(false);
+  }
+  // Parses `line` with `rule`; the tree lives until the next call.
+  template <typename Context>
+  Context* Parse(const Line& line, Context* (PlaceParser::*rule)()) {
+    tokens_.Start(line);
+    parser_.reset();  // frees the previous line's tree, starts at the first token
+    return (parser_.*rule)();
+  }
+
+ private:
+  LineTokens tokens_;
+  PlaceParser parser_;
+};
+
 ir::Program Session::Run() {
   ir::Program program;
   program.file = file_;
+  SplitLines();
+  PreScan();
   try {
     SyntaxErrorListener listener(*this);
-    Lex(listener);
-    PreScan();
-    antlr4::ListTokenSource source(ParserTokens());
-    antlr4::CommonTokenStream tokens(&source);
-    PlaceParser parser(&tokens);
-    parser.removeErrorListeners();
-    parser.addErrorListener(&listener);
-    parser.setErrorHandler(std::make_shared<LineErrorStrategy>(*this));
-    // One top-level line (a declaration, or a whole Function) at a time,
-    // freeing its parse tree once it is IR: the tree of a large program
-    // would take several times the memory of its IR.
-    IrBuilder builder(*this);
-    IrBuilder::BlockWalker top(builder, 1);
-    while (tokens.LA(1) != Token::EOF) {
-      std::size_t before = tokens.index();
-      P::ProgramLineContext* line = parser.programLine();
-      if (P::TopLevelContext* item = line->topLevel()) top.Add(item);
-      parser.getTreeTracker().reset();
-      if (tokens.index() == before) parser.consume();  // never loop in place
+    LineParser parser(*this, listener, std::make_shared<LineErrorStrategy>(*this));
+    IrBuilder ir(*this);
+    BlockBuilder blocks(*this, ir);
+    auto close_added = [&](std::span<const Closer> closers) {
+      for (const Closer& closer : closers) {
+        const PlaceToken& at = At(closer.at);
+        std::size_t opener = closer.type == P::FEND ? P::FUNCTION
+                             : closer.type == P::NEXT ? P::FOR
+                             : closer.type == P::ENDIF ? P::IF
+                                                      : P::CYCLE;
+        blocks.Close(opener, at.line, ir.End(at));
+      }
+    };
+    for (std::uint32_t n = 1; n < lines_.size(); ++n) {
+      const Line& line = lines_[n];
+      close_added(ClosersBefore(line));
+      if (line.empty()) continue;
+      switch (TypeOf(At(line.first))) {
+        case P::FUNCTION: {
+          P::FunctionHeadContext* head = parser.Parse(line, &PlaceParser::functionHead);
+          blocks.Open(P::FUNCTION, n, [&] { return ir.FunctionHead(head); });
+          break;
+        }
+        case P::FOR: {
+          P::ForHeadContext* head = parser.Parse(line, &PlaceParser::forHead);
+          blocks.Open(P::FOR, n, [&] { return ir.ForHead(head); });
+          break;
+        }
+        case P::IF: {
+          P::IfHeadContext* head = parser.Parse(line, &PlaceParser::ifHead);
+          blocks.Open(P::IF, n, [&] { return ir.IfHead(head); });
+          break;
+        }
+        case P::CYCLE: {
+          P::CycleHeadContext* head = parser.Parse(line, &PlaceParser::cycleHead);
+          blocks.Open(P::CYCLE, n, [&] { return ir.CycleHead(head); });
+          break;
+        }
+        case P::ELSEIF: {
+          P::ElseIfHeadContext* head = parser.Parse(line, &PlaceParser::elseIfHead);
+          blocks.ElseIf(n, [&] { return ir.ElseIfHead(head); });
+          break;
+        }
+        case P::ELSE: {
+          P::ElseHeadContext* head = parser.Parse(line, &PlaceParser::elseHead);
+          blocks.Else(n, ir.ElseHead(head));
+          break;
+        }
+        case P::FEND:
+          blocks.Close(P::FUNCTION, n, ir.End(parser.Parse(line, &PlaceParser::fendLine)->getStart()));
+          break;
+        case P::NEXT: {
+          P::NextLineContext* next = parser.Parse(line, &PlaceParser::nextLine);
+          blocks.Close(P::FOR, n, ir.End(next->getStart()), ir.Name(next->var), ir.Loc(next->var));
+          break;
+        }
+        case P::ENDIF:
+          blocks.Close(P::IF, n, ir.End(parser.Parse(line, &PlaceParser::endIfLine)->getStart()));
+          break;
+        case P::ENDCYCLE:
+          blocks.Close(P::CYCLE, n, ir.End(parser.Parse(line, &PlaceParser::endCycleLine)->getStart()));
+          break;
+        default:
+          if (blocks.AtTopLevel()) {
+            P::DeclarationLineContext* decl = parser.Parse(line, &PlaceParser::declarationLine);
+            blocks.Statement(n, [&] { return ir.Declaration(decl->item); });
+          } else {
+            P::StatementLineContext* stmt = parser.Parse(line, &PlaceParser::statementLine);
+            blocks.Statement(n, [&] { return ir.Statement(stmt->item); });
+          }
+      }
     }
-    program.items = top.Finish(last_line() + 1);
-  } catch (const std::exception& e) {
+    close_added(ClosersAtEnd());
+    program.items = blocks.Finish(last_line() + 1);
+  } catch (const antlr4::RuntimeException& e) {
     // ANTLR gave up in a way its recovery does not cover; say so plainly.
     Error(DiagKind::SyntaxError, SourceLoc{file_, 0, 0},
           fmt::format("the parser stopped ({}); fix the other errors and try again", e.what()));
@@ -1512,6 +1707,22 @@ void Session::Flush() {
 
 }  // namespace
 
-ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags) { return Session(file, diags).Run(); }
+ir::Program ParseTokens(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags) {
+  return Session(file, std::move(tokens), diags).Run();
+}
+
+ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags) {
+  const std::string& text = diags.sources().File(file).text;
+  if (text.size() >= UINT32_MAX) {
+    diags.Report(DiagKind::SyntaxError, SourceLoc{file, 0, 0},
+                 fmt::format("the file has {} bytes; smtcal reads .place files of less than 4 GiB, so split the "
+                             "program into several files",
+                             text.size()));
+    ir::Program program;
+    program.file = file;
+    return program;
+  }
+  return ParseTokens(file, LexPlace(text), diags);
+}
 
 }  // namespace smtcal

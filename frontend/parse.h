@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "base/diagnostics.h"
+#include "frontend/place_lexer.h"
 #include "ir/ir.h"
 
 namespace smtcal {
@@ -13,6 +15,13 @@ namespace smtcal {
 // are reported to `diags` (bounded: a file of garbage gives a handful of
 // errors, not one per byte). The returned program holds everything that
 // parsed; when diags has errors it must not be compiled, only inspected.
+// Memory is the IR, the file's tokens (20 bytes each) and one line's parse
+// tree at a time; running out of it throws std::bad_alloc, never a syntax
+// error.
 ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags);
+
+// The same from tokens already made for the file's text, by LexPlace or by
+// the reference lexer (the differential test parses with both).
+ir::Program ParseTokens(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags);
 
 }  // namespace smtcal

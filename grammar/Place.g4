@@ -1,105 +1,106 @@
 // Place.g4 - the .place robot language (docs/language.md is the reference).
 // SPEL+ flavour: case-insensitive keywords, ' comments, one statement per line.
 // Generated into the build tree at build time; frontend/parse.cpp is the only
-// code that sees the generated types.
+// code that sees the generated parser (frontend/place_lexer.cpp takes the
+// token types from the generated lexer, which the differential test of the
+// hand-written lexer runs as its reference).
 grammar Place;
 
-// ---------------------------------------------------------------- structure
-// A line is the unit of error recovery: each line is its own rule ending in
-// its NEWLINE, so a mistake anywhere in a line is caught inside that line and
-// never abandons the block around it. Every line ends in NEWLINE:
-// frontend/parse.cpp adds one after a last line that lacks it. (Allowing
-// "topLevel? EOF" would make ANTLR look ahead through a whole Function to
-// choose between the two ways to end a line.)
-program     : programLine* EOF ;
-programLine : topLevel? NEWLINE ;
-
-topLevel    : programDecl
-            | unitsDecl
-            | fixtureDecl
-            | localDecl
-            | pointDecl
-            | palletDecl
-            | vacuumDecl
-            | varDecl
-            | functionDecl
-            ;
-
-programDecl : PROGRAM ID ;
-unitsDecl   : UNITS ID ;
-fixtureDecl : FIXTURE ID ;
-localDecl   : LOCAL ID '=' coords (IN ID)? ;
-pointDecl   : TAUGHT? POINT ID '=' coords ((IN | ON) ID)? ;
-palletDecl  : PALLET NUMBER ',' ID ',' ID ',' ID ',' NUMBER ',' NUMBER ;
-vacuumDecl  : VACUUM NUMBER ;
-varDecl     : (INTEGER | REAL) ID (',' ID)* ;
-functionDecl: functionHead block FEND ;
-// The opening line of each block is its own rule, for the same reason.
-functionHead: FUNCTION ID ('(' ')')? NEWLINE ;
-
-coords      : XY '(' signedNumber ',' signedNumber ',' signedNumber ',' signedNumber ')' ;
-signedNumber: ('-' | '+')? NUMBER ;
-
-block       : blockLine* ;
-blockLine   : statement? NEWLINE ;
-
-statement   : varDecl
-            | assignment
-            | motion
-            | pickPlace
-            | onOff
-            | waitStmt
-            | forStmt
-            | ifStmt
-            | callStmt
-            | cycleStmt
-            | scanStmt
-            | exitStmt
-            ;
-
-assignment  : ID '=' expr ;
-motion      : (JUMP | GO | MOVE) pointExpr (LIMZ expr)? ;
-pickPlace   : (PICK | PLACE) pointExpr (VACUUM expr)? (LIMZ expr)? ;
-onOff       : (ON | OFF) expr ;
-// Wait Sw(n) = On|Off waits for an input; any other Wait expr waits that
-// many seconds. Both are one rule (LL(1)); the visitor tells them apart.
-waitStmt    : WAIT expr ;
-forStmt     : forHead block NEXT ID? ;
-forHead     : FOR ID '=' expr TO expr (STEP expr)? NEWLINE ;
-ifStmt      : ifHead block elseIfPart* elsePart? ENDIF ;
-ifHead      : IF expr THEN NEWLINE ;
-elseIfPart  : elseIfHead block ;
-elseIfHead  : ELSEIF expr THEN NEWLINE ;
-elsePart    : elseHead block ;
+// ---------------------------------------------------------------- lines
+// frontend/parse.cpp parses one line at a time: it calls the rule for the
+// line's kind (known from its first word), builds the line's IR from the
+// labelled elements and frees the line's parse tree. The blocks (Function
+// ... Fend, For ... Next, If ... EndIf, Cycle ... EndCycle) are put
+// together by parse.cpp from the nesting its pre-scan has checked and
+// repaired, so a mistake anywhere in a line is caught inside that line and
+// never abandons the block around it. Every line rule ends in the line's
+// NEWLINE: parse.cpp gives each line one (also a last line that lacks it).
+// parse.cpp reads the elements it needs through their labels only: it does
+// not have ANTLR build the children lists of the parse tree.
+declarationLine : item=declaration NEWLINE ;
+statementLine   : item=statement NEWLINE ;
+// The lines that open and close blocks.
+functionHead: FUNCTION name=ID ('(' ')')? NEWLINE ;
+forHead     : FOR var=ID '=' from=expr TO to=expr (STEP step=expr)? NEWLINE ;
+ifHead      : IF condition=expr THEN NEWLINE ;
+elseIfHead  : ELSEIF condition=expr THEN NEWLINE ;
 elseHead    : ELSE NEWLINE ;
-callStmt    : CALL ID ('(' ')')? ;
-cycleStmt   : cycleHead block ENDCYCLE ;
-cycleHead   : CYCLE ID NEWLINE ;
-scanStmt    : SCAN ID ;
+cycleHead   : CYCLE fixture=ID NEWLINE ;
+fendLine    : FEND NEWLINE ;
+nextLine    : NEXT var=ID? NEWLINE ;
+endIfLine   : ENDIF NEWLINE ;
+endCycleLine: ENDCYCLE NEWLINE ;
+
+// ---------------------------------------------------------------- declarations
+// The labels (here and in statement) name the alternative's context, so
+// parse.cpp reaches it without a search through the children.
+declaration : programAlt=programDecl
+            | unitsAlt=unitsDecl
+            | fixtureAlt=fixtureDecl
+            | localAlt=localDecl
+            | pointAlt=pointDecl
+            | palletAlt=palletDecl
+            | vacuumAlt=vacuumDecl
+            | varDeclAlt=varDecl
+            ;
+
+programDecl : PROGRAM name=ID ;
+unitsDecl   : UNITS unit=ID ;
+fixtureDecl : FIXTURE name=ID ;
+localDecl   : LOCAL name=ID '=' origin=coords (IN frame=ID)? ;
+pointDecl   : taught=TAUGHT? POINT name=ID '=' position=coords (frameKeyword=(IN | ON) frame=ID)? ;
+palletDecl  : PALLET number=NUMBER ',' corner1=ID ',' corner2=ID ',' corner3=ID ',' columns=NUMBER ',' rows=NUMBER ;
+vacuumDecl  : VACUUM output=NUMBER ;
+varDecl     : type=(INTEGER | REAL) names+=ID (',' names+=ID)* ;
+
+coords      : XY '(' x=signedNumber ',' y=signedNumber ',' z=signedNumber ',' u=signedNumber ')' ;
+signedNumber: sign=('-' | '+')? value=NUMBER ;
+
+// ---------------------------------------------------------------- statements
+statement   : varDeclAlt=varDecl
+            | assignmentAlt=assignment
+            | motionAlt=motion
+            | pickPlaceAlt=pickPlace
+            | onOffAlt=onOff
+            | waitAlt=waitStmt
+            | callAlt=callStmt
+            | scanAlt=scanStmt
+            | exitAlt=exitStmt
+            ;
+
+assignment  : name=ID '=' value=expr ;
+motion      : kind=(JUMP | GO | MOVE) target=pointExpr (limzKeyword=LIMZ limz=expr)? ;
+pickPlace   : kind=(PICK | PLACE) target=pointExpr (VACUUM vacuum=expr)? (LIMZ limz=expr)? ;
+onOff       : state=(ON | OFF) bit=expr ;
+// Wait Sw(n) = On|Off waits for an input; any other Wait expr waits that
+// many seconds. Both are one rule (LL(1)); parse.cpp tells them apart.
+waitStmt    : WAIT value=expr ;
+callStmt    : CALL name=ID ('(' ')')? ;
+scanStmt    : SCAN fixture=ID ;
 exitStmt    : EXIT FUNCTION ;
 
 // ---------------------------------------------------------------- points
 // P + X(d): the offset axis is an identifier (X, Y, Z or U) so that x, y, z
 // and u stay usable as variable names; the parser checks it.
-pointExpr   : pointAtom (('+' | '-') offset)* ;
-pointAtom   : ID                                                # namedPoint
-            | coords                                            # literalPoint
-            | PALLET '(' expr ',' expr (',' expr)? ')'          # palletPoint
+pointExpr   : base=pointAtom (signs+=('+' | '-') offsets+=offset)* ;
+pointAtom   : name=ID                                                     # namedPoint
+            | position=coords                                             # literalPoint
+            | PALLET '(' number=expr ',' i=expr (',' j=expr)? ')'         # palletPoint
             ;
-offset      : ID '(' expr ')' ;
+offset      : axis=ID '(' amount=expr ')' ;
 
 // ---------------------------------------------------------------- expressions
-expr        : '(' expr ')'                                      # parenExpr
-            | op=('-' | '+' | NOT) expr                         # unaryExpr
-            | expr op=('*' | '/' | MOD) expr                    # binaryExpr
-            | expr op=('+' | '-') expr                          # binaryExpr
-            | expr op=('=' | '<>' | '<' | '>' | '<=' | '>=') expr # binaryExpr
-            | expr op=AND expr                                  # binaryExpr
-            | expr op=(OR | XOR) expr                           # binaryExpr
-            | SW '(' expr ')'                                   # switchExpr
-            | (ON | OFF)                                        # onOffExpr
-            | NUMBER                                            # numberExpr
-            | ID                                                # variableExpr
+expr        : '(' inner=expr ')'                                          # parenExpr
+            | op=('-' | '+' | NOT) operand=expr                           # unaryExpr
+            | lhs=expr op=('*' | '/' | MOD) rhs=expr                      # binaryExpr
+            | lhs=expr op=('+' | '-') rhs=expr                            # binaryExpr
+            | lhs=expr op=('=' | '<>' | '<' | '>' | '<=' | '>=') rhs=expr # binaryExpr
+            | lhs=expr op=AND rhs=expr                                    # binaryExpr
+            | lhs=expr op=(OR | XOR) rhs=expr                             # binaryExpr
+            | SW '(' bit=expr ')'                                         # switchExpr
+            | value=(ON | OFF)                                            # onOffExpr
+            | value=NUMBER                                                # numberExpr
+            | name=ID                                                     # variableExpr
             ;
 
 // ---------------------------------------------------------------- tokens
