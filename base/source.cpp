@@ -9,7 +9,8 @@
 #include <sstream>
 
 #include <fmt/core.h>
-#include <unistd.h>
+
+#include "base/text_output.h"
 
 namespace smtcal {
 
@@ -54,31 +55,10 @@ const SourceFile& SourceManager::File(std::uint32_t id) const {
 }
 
 Status WriteFileAtomically(const std::string& path, std::string_view contents) {
-  if (path == "-") {
-    std::cout.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    std::cout.flush();
-    if (!std::cout) return Error{"cannot write to standard output"};
-    return Ok{};
-  }
-  std::string temp = fmt::format("{}.tmp.{}", path, ::getpid());
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    // Name the file the user asked for; the temporary is our business.
-    if (!out) return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    out.flush();
-    if (!out) {
-      std::remove(temp.c_str());
-      return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
-    }
-  }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    int saved = errno;
-    std::remove(temp.c_str());
-    return Error{fmt::format("cannot write '{}' (renaming the finished temporary '{}' failed): {}",
-                             path, temp, std::strerror(saved))};
-  }
-  return Ok{};
+  Result<std::unique_ptr<TextOutput>> output = TextOutput::Open(path);
+  if (!output) return output.error();
+  output.value()->Append(contents);
+  return output.value()->Commit();
 }
 
 }  // namespace smtcal

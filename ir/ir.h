@@ -19,6 +19,9 @@
 namespace smtcal {
 struct CompileState;  // passes/correction/compile_state.h
 }
+namespace smtcal::sema {
+class SymbolTable;  // ir/symbols.h
+}
 
 namespace smtcal::ir {
 
@@ -249,6 +252,9 @@ struct Program {
   // Set by the bind pass when the program is compiled for a cell; what the
   // correction passes found (passes/correction/compile_state.h). Null for `check`.
   std::shared_ptr<CompileState> compile;
+  // The top-level symbol table every pass shares, made on first use by
+  // sema::SymbolsOf (ir/symbols.h).
+  mutable std::shared_ptr<const sema::SymbolTable> symbols;
 };
 
 }  // namespace smtcal::ir

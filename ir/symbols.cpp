@@ -6,7 +6,8 @@
 namespace smtcal::sema {
 namespace {
 
-char LowerChar(char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); }
+// ASCII only: names are ASCII, and they compare the same in every locale.
+char LowerChar(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
 
 }  // namespace
 
@@ -36,6 +37,12 @@ std::string Lowercase(std::string_view name) {
 bool SameName(std::string_view a, std::string_view b) {
   return a.size() == b.size() &&
          std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return LowerChar(x) == LowerChar(y); });
+}
+
+std::size_t NameHash::operator()(std::string_view name) const {
+  std::size_t hash = 14695981039346656037ull;  // FNV-1a of the lowercased bytes
+  for (char c : name) hash = (hash ^ static_cast<unsigned char>(LowerChar(c))) * 1099511628211ull;
+  return hash;
 }
 
 SourceRange NameAt(SourceLoc loc, std::string_view name) {
@@ -94,23 +101,51 @@ SymbolTable SymbolTable::Build(const ir::Program& program) {
       if (!inserted) table.duplicate_pallets_.emplace_back(it->second, entry);
     }
   }
+  // The fixtures of the frames and pallets, once: every target asks.
+  for (const Symbol& symbol : table.symbols_) {
+    if (symbol.kind == SymbolKind::Local) table.fixture_of_local_.emplace(&symbol, table.WalkToFixture(symbol));
+  }
+  for (const auto& [number, entry] : table.pallets_) table.fixture_of_pallet_.emplace(number, table.PalletFixture(number));
   return table;
 }
 
 void SymbolTable::Add(Symbol symbol) {
-  std::string key = Lowercase(symbol.name);
-  auto it = by_name_.find(key);
+  auto it = by_name_.find(std::string_view(symbol.name));
   if (it != by_name_.end()) {
     duplicates_.push_back({*it->second, std::move(symbol)});
     return;
   }
   symbols_.push_back(std::move(symbol));
-  by_name_.emplace(std::move(key), &symbols_.back());
+  by_name_.emplace(symbols_.back().name, &symbols_.back());
 }
 
 const Symbol* SymbolTable::Find(std::string_view name) const {
-  auto it = by_name_.find(Lowercase(name));
+  auto it = by_name_.find(name);
   return it == by_name_.end() ? nullptr : it->second;
+}
+
+const SymbolTable& SymbolsOf(const ir::Program& program) {
+  if (!program.symbols) program.symbols = std::make_shared<const SymbolTable>(SymbolTable::Build(program));
+  return *program.symbols;
+}
+
+void ForgetSymbols(const ir::Program& program) { program.symbols.reset(); }
+
+bool SameSymbols(const SymbolTable& a, const SymbolTable& b) {
+  auto same = [](const Symbol& x, const Symbol& y) {
+    return x.kind == y.kind && x.name == y.name && x.decl == y.decl && x.range.begin == y.range.begin;
+  };
+  auto same_pallet = [](const SymbolTable::PalletEntry& x, const SymbolTable::PalletEntry& y) {
+    return x.stmt == y.stmt && x.pallet == y.pallet;
+  };
+  return std::equal(a.symbols().begin(), a.symbols().end(), b.symbols().begin(), b.symbols().end(), same) &&
+         std::equal(a.duplicates().begin(), a.duplicates().end(), b.duplicates().begin(), b.duplicates().end(),
+                    [&](const auto& x, const auto& y) { return same(x.first, y.first) && same(x.again, y.again); }) &&
+         a.PalletNumbers() == b.PalletNumbers() &&
+         std::equal(a.duplicate_pallets().begin(), a.duplicate_pallets().end(), b.duplicate_pallets().begin(),
+                    b.duplicate_pallets().end(), [&](const auto& x, const auto& y) {
+                      return same_pallet(x.first, y.first) && same_pallet(x.second, y.second);
+                    });
 }
 
 std::vector<std::string> SymbolTable::NamesOf(std::initializer_list<SymbolKind> kinds) const {
@@ -132,7 +167,7 @@ std::vector<int> SymbolTable::PalletNumbers() const {
   return numbers;
 }
 
-const Symbol* SymbolTable::FixtureOfFrame(const Symbol& frame) const {
+const Symbol* SymbolTable::WalkToFixture(const Symbol& frame) const {
   const Symbol* current = &frame;
   // A chain longer than the number of symbols must revisit one: a loop.
   for (std::size_t steps = 0; steps <= symbols_.size(); ++steps) {
@@ -144,6 +179,12 @@ const Symbol* SymbolTable::FixtureOfFrame(const Symbol& frame) const {
     if (current == nullptr) return nullptr;
   }
   return nullptr;
+}
+
+const Symbol* SymbolTable::FixtureOfFrame(const Symbol& frame) const {
+  if (frame.kind == SymbolKind::Fixture) return &frame;
+  auto it = fixture_of_local_.find(&frame);
+  return it != fixture_of_local_.end() ? it->second : WalkToFixture(frame);
 }
 
 const Symbol* SymbolTable::FixtureOfPoint(const Symbol& point) const {
@@ -160,6 +201,11 @@ PointFrame SymbolTable::FrameOfPoint(const Symbol& point) {
 }
 
 const Symbol* SymbolTable::FixtureOfPallet(int number) const {
+  auto it = fixture_of_pallet_.find(number);
+  return it != fixture_of_pallet_.end() ? it->second : nullptr;
+}
+
+const Symbol* SymbolTable::PalletFixture(int number) const {
   const PalletEntry* entry = FindPallet(number);
   if (entry == nullptr) return nullptr;
   const Symbol* first = nullptr;
@@ -178,17 +224,16 @@ const Symbol* SymbolTable::FixtureOfPallet(int number) const {
 // ------------------------------------------------------------------ LocalScope
 
 const Symbol* LocalScope::Declare(Symbol local) {
-  std::string key = Lowercase(local.name);
-  auto it = by_name_.find(key);
+  auto it = by_name_.find(std::string_view(local.name));
   if (it != by_name_.end()) return it->second;
   const Symbol* global = globals_.Find(local.name);
   locals_.push_back(std::move(local));
-  by_name_.emplace(std::move(key), &locals_.back());
+  by_name_.emplace(locals_.back().name, &locals_.back());
   return global;
 }
 
 const Symbol* LocalScope::Find(std::string_view name) const {
-  auto it = by_name_.find(Lowercase(name));
+  auto it = by_name_.find(name);
   if (it != by_name_.end()) return it->second;
   return globals_.Find(name);
 }
@@ -197,7 +242,7 @@ std::vector<std::string> LocalScope::VariableNames() const {
   std::vector<std::string> names;
   for (const Symbol& local : locals_) names.push_back(local.name);
   for (std::string& global : globals_.NamesOf({SymbolKind::Variable})) {
-    if (by_name_.count(Lowercase(global)) == 0) names.push_back(std::move(global));
+    if (!by_name_.contains(std::string_view(global))) names.push_back(std::move(global));
   }
   return names;
 }

@@ -4,8 +4,9 @@
 // are order-independent. Pallets are named by number and kept apart.
 //
 // Building the table never reports anything: the first definition of a name
-// wins and later ones are recorded as duplicates, so every check can build
-// its own table cheaply and only check_names reports the duplicates.
+// wins and later ones are recorded as duplicates, and only check_names
+// reports the duplicates. A compile builds it once: SymbolsOf(program) makes
+// it on first use and keeps it with the program for every later pass.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -39,6 +41,18 @@ std::string DescribeKind(const Symbol& symbol);
 // Case-insensitive key of a name.
 std::string Lowercase(std::string_view name);
 bool SameName(std::string_view a, std::string_view b);
+// Hash and equality of names as the language compares them (ASCII case
+// ignored), for maps looked up by a string_view without making a key.
+struct NameHash {
+  using is_transparent = void;
+  std::size_t operator()(std::string_view name) const;
+};
+struct NameEqual {
+  using is_transparent = void;
+  bool operator()(std::string_view a, std::string_view b) const { return SameName(a, b); }
+};
+template <typename Value>
+using NameMap = std::unordered_map<std::string, Value, NameHash, NameEqual>;
 
 // The range of `name` written at `loc` (names are kept as written, so the
 // caret underlines exactly the name).
@@ -98,13 +112,29 @@ class SymbolTable {
 
  private:
   void Add(Symbol symbol);
+  const Symbol* WalkToFixture(const Symbol& frame) const;
+  const Symbol* PalletFixture(int number) const;
 
   std::deque<Symbol> symbols_;  // deque: Find's pointers stay valid
-  std::map<std::string, const Symbol*> by_name_;
+  NameMap<const Symbol*> by_name_;  // keyed by the name as declared
   std::vector<Duplicate> duplicates_;
   std::map<int, PalletEntry> pallets_;
   std::vector<std::pair<PalletEntry, PalletEntry>> duplicate_pallets_;
+  // Made by Build, so the questions every target asks are one lookup.
+  std::unordered_map<const Symbol*, const Symbol*> fixture_of_local_;
+  std::map<int, const Symbol*> fixture_of_pallet_;
 };
+
+// The program's table, built on first use and then kept with the program
+// (ir::Program::symbols), so the passes of a compile share one. It stays
+// valid while the top-level declarations stay: a pass that adds, removes or
+// renames one calls ForgetSymbols. (--verify-each checks that no pass forgot
+// to: passes/pass.cpp.)
+const SymbolTable& SymbolsOf(const ir::Program& program);
+void ForgetSymbols(const ir::Program& program);
+// Whether two tables hold the same symbols, duplicates and pallets (the same
+// declarations, in the same order).
+bool SameSymbols(const SymbolTable& a, const SymbolTable& b);
 
 // A function's local variables, declared as a check walks the body in source
 // order (SPEL+: a local is visible from its declaration to Fend, whatever
@@ -126,7 +156,7 @@ class LocalScope {
  private:
   const SymbolTable& globals_;
   std::deque<Symbol> locals_;
-  std::map<std::string, const Symbol*> by_name_;
+  NameMap<const Symbol*> by_name_;
 };
 
 // The symbols a VarDecl statement declares (one per name).

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "ir/symbols.h"
 #include "ir/verifier.h"
 #include "passes/checks/checks.h"
 #include "passes/correction/correction_passes.h"
@@ -70,6 +71,16 @@ namespace {
 
 void VerifyOrAbort(const ir::Program& program, const Diagnostics& diags, std::string_view culprit) {
   std::vector<VerifierIssue> issues = VerifyProgram(program);
+  // The passes share one symbol table (sema::SymbolsOf): one that changed
+  // the declarations must have forgotten it.
+  if (program.symbols && !sema::SameSymbols(*program.symbols, sema::SymbolTable::Build(program))) {
+    std::fprintf(stderr,
+                 "smtcal: internal error: the shared symbol table no longer fits the program %s; a pass that "
+                 "changes declarations must call sema::ForgetSymbols. This is a bug in smtcal, not in the program.\n",
+                 std::string(culprit).c_str());
+    std::fflush(stderr);
+    std::abort();
+  }
   if (issues.empty()) return;
   std::string report = fmt::format(
       "smtcal: internal error: the IR is broken {} ({} problem{}); this is a bug in smtcal, not "

@@ -76,10 +76,26 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
   const CompileState& state = *compiled.program.compile;
-  // The LinuxCNC emitter reports what it cannot lower with the passes' diagnostics.
+  // The LinuxCNC emitter reports what it cannot lower with the passes'
+  // diagnostics; it writes the main program as it goes (into the output
+  // directory's temporary, or into memory for -o -).
   std::optional<LinuxCncOutput> linuxcnc;
+  std::unique_ptr<LinuxCncDirectory> directory;
+  TextOutput review;  // -o -, or where the text goes when the directory cannot be written
+  Status opened = Ok{};
   if (opt.target == "linuxcnc" && !diags.has_errors()) {
-    linuxcnc = EmitLinuxCnc(compiled.program, state, opt.program_path, diags);
+    TextOutput* main = &review;
+    if (opt.output != "-") {
+      Result<std::unique_ptr<LinuxCncDirectory>> open =
+          LinuxCncDirectory::Open(opt.output, LinuxCncMainName(opt.program_path));
+      if (open) {
+        directory = std::move(open).value();
+        main = &directory->main();
+      } else {
+        opened = open.error();  // reported after the diagnostics, as a failed write is
+      }
+    }
+    linuxcnc = EmitLinuxCnc(compiled.program, state, opt.program_path, *main, diags);
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;  // nothing half-written
@@ -95,7 +111,6 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
     text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
   } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
-    text = PrintPlace(compiled.program);
   }
   if (!opt.report.empty()) {
     std::string report = CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n";
@@ -104,9 +119,11 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       return;
     }
   }
-  Status written = !linuxcnc             ? WriteFileAtomically(opt.output, text)
-                   : opt.output == "-"    ? WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc))
-                                          : WriteLinuxCncDirectory(opt.output, *linuxcnc);
+  Status written = opt.target == "c"       ? WriteFileAtomically(opt.output, text)
+                   : opt.target == "place" ? WritePlace(opt.output, compiled.program)
+                   : !opened               ? opened
+                   : directory             ? directory->Commit(*linuxcnc)
+                                           : WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc, review.text()));
   if (!written) options.exit_code = ReportIoError(written.error());
 }
 

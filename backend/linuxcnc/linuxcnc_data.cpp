@@ -5,8 +5,10 @@
 // assignment per line with a comment naming what it is.
 #include "backend/linuxcnc/linuxcnc_data.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdlib>
+#include <system_error>
 #include <vector>
 
 #include <fmt/format.h>
@@ -19,16 +21,50 @@ namespace smtcal {
 
 namespace L = linuxcnc_layout;
 
-std::string LinuxCncNumber(double value) {
+void AppendLinuxCncNumber(std::string& out, double value) {
   SMTCAL_CHECK(std::isfinite(value), "a non-finite number in the LinuxCNC runtime data");
-  if (value == 0) return "0";
-  // The shortest fixed-point form that reads back as the same double.
-  for (int digits = 0; digits <= 400; ++digits) {
-    std::string text = fmt::format("{:.{}f}", value, digits);
-    if (std::strtod(text.c_str(), nullptr) == value) return text;
+  if (value == 0) {
+    out += '0';
+    return;
+  }
+  // The fewest decimals that read back as the same double, correctly rounded
+  // (printf's %.Nf). The shortest fixed form that reads back (to_chars
+  // without a precision) has that many decimals, and it is the correctly
+  // rounded one, except where it may pick other digits: beyond 2^53 (it
+  // writes zeros for the digits it does not need) and at a power of two
+  // with decimals (the doubles below lie closer than those above, so the
+  // nearest decimal may not read back, where a farther one above does).
+  // There the decimals are rounded as printf does and checked, one more at a
+  // time.
+  char text[kMaxLinuxCncNumberChars];
+  char* const end = text + sizeof text;
+  auto shortest = std::to_chars(text, end, value, std::chars_format::fixed);
+  SMTCAL_CHECK(shortest.ec == std::errc(), "a double's shortest decimal fits the buffer");
+  int exponent = 0;
+  const bool power_of_two = std::abs(std::frexp(value, &exponent)) == 0.5;
+  if (std::abs(value) < 0x1p53 && (!power_of_two || value == std::trunc(value))) {
+    out.append(text, shortest.ptr);
+    return;
+  }
+  const char* point = std::find(text, shortest.ptr, '.');
+  int digits = point == shortest.ptr ? 0 : static_cast<int>(shortest.ptr - point - 1);
+  for (; digits <= kMaxLinuxCncDecimals; ++digits) {
+    auto rounded = std::to_chars(text, end, value, std::chars_format::fixed, digits);
+    SMTCAL_CHECK(rounded.ec == std::errc(), "a double's fixed decimal fits the buffer");
+    double back = 0;
+    std::from_chars(text, rounded.ptr, back, std::chars_format::fixed);
+    if (back == value) {
+      out.append(text, rounded.ptr);
+      return;
+    }
   }
   SMTCAL_CHECK(false, "a number without an exact decimal form");
-  return "0";
+}
+
+std::string LinuxCncNumber(double value) {
+  std::string out;
+  AppendLinuxCncNumber(out, value);
+  return out;
 }
 
 namespace {

@@ -8,6 +8,7 @@
 // back exactly (rs274 reads no exponents).
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
@@ -52,8 +53,15 @@ std::optional<std::string> LinuxCncDataProblem(const cell::Cell& cell);
 // checked).
 std::string EmitLinuxCncData(const cell::Cell& cell);
 
-// A number as rs274 reads it back exactly: a plain decimal (no exponent), the
-// fewest digits that round-trip.
+// A number as rs274 reads it back exactly: a plain decimal (no exponent) with
+// the fewest decimals that round-trip, correctly rounded; "0" for zero.
 std::string LinuxCncNumber(double value);
+// The same appended to `out` (no temporary string).
+void AppendLinuxCncNumber(std::string& out, double value);
+// More decimals than any double needs to read back (the smallest subnormal
+// needs 324), and the longest text: 309 digits before the point, the point,
+// the decimals, a sign.
+inline constexpr int kMaxLinuxCncDecimals = 400;
+inline constexpr std::size_t kMaxLinuxCncNumberChars = 309 + 1 + kMaxLinuxCncDecimals + 1;
 
 }  // namespace smtcal

@@ -20,12 +20,14 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -53,6 +55,10 @@ constexpr std::size_t kMaxQuotedChars = 60;
 // A `Wait Sw(n) = On` waits in slices of this many seconds (M66 needs a
 // timeout) until the input has the state: the language's Wait has none.
 constexpr double kWaitSliceS = 3600;
+// o<pick_place>'s first argument besides a fixture's index: a base position
+// the runtime corrects through the error tables, or a position as given.
+constexpr int kPickPlaceBase = -1;
+constexpr int kPickPlaceAsWritten = -2;
 
 // Comment text rs274 accepts: no parentheses (they would end the comment),
 // no commas right after a word rs274 treats as a command (msg, debug, abort,
@@ -76,6 +82,14 @@ std::string Sanitize(std::string_view text) {
   return out;
 }
 
+// Text for an (abort, ...) message: a comment's text in which rs274 would
+// substitute nothing (it substitutes parameters, #..., with formats, %...).
+std::string SanitizeMessage(std::string_view text) {
+  std::string out = Sanitize(text);
+  std::replace_if(out.begin(), out.end(), [](char c) { return c == '#' || c == '%'; }, '?');
+  return out;
+}
+
 // Source text for a comment, cut so the line stays within kMaxLineChars.
 std::string Quoted(std::string_view text) {
   if (text.size() <= kMaxQuotedChars) return std::string(text);
@@ -91,32 +105,37 @@ using GExpr = std::string;
 
 class Emitter {
  public:
-  Emitter(const ir::Program& program, const CompileState& state, std::string source_name, Diagnostics& diags)
+  Emitter(const ir::Program& program, const CompileState& state, std::string source_name, TextOutput& out,
+          Diagnostics& diags)
       : program_(program),
         state_(state),
         cell_(*state.cell),
-        symbols_(sema::SymbolTable::Build(program)),
+        symbols_(sema::SymbolsOf(program)),
         source_name_(std::move(source_name)),
-        diags_(diags) {}
+        diags_(diags),
+        out_(out) {}
 
-  std::optional<std::string> Run() {
+  // False when the program cannot be lowered (reported); the text is then
+  // incomplete.
+  bool Run() {
     if (!cell_.linuxcnc) {
       diags_.Report(DiagKind::LinuxCncNoCellTable, SourceRange(SourceLoc{cell_.file, 1, 1}));
-      return std::nullopt;
+      return false;
     }
     linuxcnc_ = &*cell_.linuxcnc;
     CheckProgram();
-    if (diags_.has_errors()) return std::nullopt;
+    if (diags_.has_errors()) return false;
     ClassifyTargets();
     EmitHeader();
     EmitPoints();
     EmitGlobals();
+    EmitPickPlaceSubroutine();
     for (const ir::StmtPtr& item : program_.items) {
       if (const auto* function = std::get_if<ir::Function>(&item->node)) EmitFunction(*item, *function);
     }
     Line("o<fn_main> call", MainLoc());
     Line("M2", MainLoc());
-    return out_;
+    return true;
   }
 
  private:
@@ -200,14 +219,13 @@ class Emitter {
   // Base-frame statements: commanded as written when every target the
   // compile-time run found is static (the IR already holds its nominal
   // XY(...)) or uncorrected; corrected on the controller otherwise.
-  // Also remembers each statement's first target text and the program's
-  // Vacuum default, so emitting stays linear in the program's size.
+  // Also remembers the program's Vacuum default, so emitting stays linear in
+  // the program's size.
   void ClassifyTargets() {
     for (const Target& target : state_.targets) {
       bool as_written = target.kind == CorrectionKind::kStatic || target.kind == CorrectionKind::kUncorrected;
       auto [it, inserted] = as_written_.emplace(target.stmt, as_written);
       if (!inserted) it->second = it->second && as_written;
-      target_text_.emplace(target.stmt, target.text);
     }
     for (const ir::StmtPtr& item : program_.items) {
       if (const auto* decl = std::get_if<ir::VacuumDecl>(&item->node)) default_vacuum_ = decl->output;
@@ -215,7 +233,7 @@ class Emitter {
   }
 
   // The cell's index of the fixture a point expression hangs on, or -1.
-  int FixtureIndexOf(const ir::PointExpr& point) const {
+  int FixtureIndexOf(const ir::PointExpr& point) {
     const sema::Symbol* fixture = nullptr;
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
       if (const sema::Symbol* symbol = symbols_.Find(named->name)) fixture = symbols_.FixtureOfPoint(*symbol);
@@ -225,7 +243,9 @@ class Emitter {
       }
     }
     if (fixture == nullptr) return -1;
-    return CellFixtureIndex(fixture->name);
+    auto [it, inserted] = cell_fixture_of_.emplace(fixture, 0);
+    if (inserted) it->second = CellFixtureIndex(fixture->name);
+    return it->second;
   }
 
   int CellFixtureIndex(std::string_view name) const {
@@ -234,8 +254,10 @@ class Emitter {
     return static_cast<int>(fixture - cell_.fixtures.data());
   }
 
-  Command CommandOf(const ir::Stmt& stmt, const ir::PointExpr& point) const {
-    if (FixtureIndexOf(point) >= 0) return Command::kFixture;
+  Command CommandOf(const ir::Stmt& stmt, const ir::PointExpr& point, int* fixture = nullptr) {
+    int index = FixtureIndexOf(point);
+    if (fixture != nullptr) *fixture = index;
+    if (index >= 0) return Command::kFixture;
     auto it = as_written_.find(&stmt);
     // A statement the compile-time run never reached is corrected on the
     // controller, like any base target smtcal could not compute.
@@ -254,36 +276,71 @@ class Emitter {
 
   // One block: indentation, the text, the source-line comment.
   void Line(std::string_view text, SourceLoc loc) {
-    Emit(fmt::format("{}{} ({})", std::string(static_cast<std::size_t>(indent_) * 2, ' '), text,
-                     Sanitize(Where(loc))), loc);
+    std::string& out = Begin();
+    const std::size_t begin = out.size();
+    out += text;
+    out += Suffix(loc);
+    Ended(begin, loc);
+  }
+  // " (layers.place:57)\n", the end of every block of source line 57: made
+  // once per source line, as a statement's blocks come one after another.
+  const std::string& Suffix(SourceLoc loc) {
+    if (!suffix_made_ || loc.line != suffix_line_) {
+      suffix_.assign(" (");
+      AppendWhere(suffix_, loc);
+      suffix_ += ")\n";
+      suffix_line_ = loc.line;
+      suffix_made_ = true;
+    }
+    return suffix_;
+  }
+  // "layers.place:57", as Sanitize(Where(loc)) gives it (a line number
+  // needs no sanitizing).
+  void AppendWhere(std::string& out, SourceLoc loc) {
+    if (source_where_.empty()) source_where_ = Sanitize(Quoted(source_name_)) + ":";
+    out += source_where_;
+    char digits[16];
+    out.append(digits, std::to_chars(digits, digits + sizeof digits, loc.line).ptr);
+  }
+  // The output with the indentation of a new line appended.
+  std::string& Begin() {
+    std::string& out = out_.buffer();
+    out.append(static_cast<std::size_t>(indent_) * 2, ' ');
+    return out;
+  }
+  // The line that started at `begin` is complete (with its newline). One
+  // rs274 cannot read is an error of the statement it came from (once per
+  // statement), never output.
+  void Ended(std::size_t begin, SourceLoc loc) {
+    const std::size_t length = out_.buffer().size() - begin - 1 + static_cast<std::size_t>(indent_) * 2;
+    if (length > kMaxLineChars) {
+      SMTCAL_CHECK(loc.known(), "only blocks from statements can grow long; comments are cut");
+      if (too_long_.insert({loc.line, loc.column}).second) {
+        diags_.Report(DiagKind::LinuxCncLineTooLong, SourceRange(loc), length, kMaxLineChars);
+      }
+    }
+    out_.Produced();
   }
   // A comment line is cut to fit: it only informs.
   void Comment(std::string_view text) {
-    std::string indent(static_cast<std::size_t>(indent_) * 2, ' ');
     std::string body = Sanitize(text);
-    std::size_t room = kMaxLineChars - indent.size() - 2;
+    std::size_t room = kMaxLineChars - static_cast<std::size_t>(indent_) * 2 - 2;
     if (body.size() > room) body = body.substr(0, room - 3) + "...";
-    Emit(fmt::format("{}({})", indent, body), SourceLoc{});
-  }
-  // A line rs274 cannot read is an error of the statement it came from
-  // (once per statement), never output.
-  void Emit(const std::string& line, SourceLoc loc) {
-    if (line.size() > kMaxLineChars) {
-      SMTCAL_CHECK(loc.known(), "only blocks from statements can grow long; comments are cut");
-      if (too_long_.insert({loc.line, loc.column}).second) {
-        diags_.Report(DiagKind::LinuxCncLineTooLong, SourceRange(loc), line.size(), kMaxLineChars);
-      }
-    }
-    out_ += line;
-    out_ += '\n';
+    std::string& out = Begin();
+    out += '(';
+    out += body;
+    out += ")\n";
+    out_.Produced();
   }
   void Comment(std::string_view text, SourceLoc loc) { Comment(fmt::format("{} {}", text, Where(loc))); }
   std::set<std::pair<std::uint32_t, std::uint32_t>> too_long_;  // statements reported
   void Abort(std::string_view message, SourceLoc loc) {
     // The abort's own text is the message; the location is inside it.
-    Emit(fmt::format("{}(abort, smtcal: {} at {})", std::string(static_cast<std::size_t>(indent_) * 2, ' '),
-                     Sanitize(message), Sanitize(Where(loc))),
-         loc);
+    std::string& out = Begin();
+    const std::size_t begin = out.size();
+    fmt::format_to(std::back_inserter(out), "(abort, smtcal: {} at {})\n", SanitizeMessage(message),
+                   SanitizeMessage(Where(loc)));
+    Ended(begin, loc);
   }
   int NextOWord() { return next_oword_++; }
   // Temporaries live for one statement, so their names repeat; only the
@@ -292,12 +349,12 @@ class Emitter {
   std::string SwitchTemp() { return fmt::format("#<t_sw{}>", next_switch_++); }
 
   void EmitHeader() {
-    out_ += fmt::format("{}{})\n", kHeaderMark,
-                        Sanitize(fmt::format("{}: {} for LinuxCNC and cell {}. Do not edit: compile the source again.",
-                                             SMTCAL_VERSION, Quoted(source_name_), Quoted(cell_.name))));
-    out_ += "(Needs the subroutines directory of this output on [RS274NGC]SUBROUTINE_PATH; docs/linuxcnc.md.)\n";
-    out_ += fmt::format("(mm and degrees; u on the {} axis; vacuum sensor on motion.digital-in-{:02}.)\n",
-                        linuxcnc_->rotation_axis, linuxcnc_->vacuum_sensor_input);
+    out_.Append(fmt::format("{}{})\n", kHeaderMark,
+                            Sanitize(fmt::format("{}: {} for LinuxCNC and cell {}. Do not edit: compile the source again.",
+                                                 SMTCAL_VERSION, Quoted(source_name_), Quoted(cell_.name)))));
+    out_.Append("(Needs the subroutines directory of this output on [RS274NGC]SUBROUTINE_PATH; docs/linuxcnc.md.)\n");
+    out_.Append(fmt::format("(mm and degrees; u on the {} axis; vacuum sensor on motion.digital-in-{:02}.)\n",
+                            linuxcnc_->rotation_axis, linuxcnc_->vacuum_sensor_input));
     SourceLoc loc = ProgramLoc();
     Line("G21 G90 G17 G94", loc);
     Line("o<smtcal_data> call", loc);
@@ -310,23 +367,43 @@ class Emitter {
     return SourceLoc{};
   }
 
-  // Points: their coordinates in the root frame (a fixture's or the base's).
+  // Points: their coordinates in the root frame (a fixture's or the base's),
+  // the four parameters on one line with the declaration in its comment; a
+  // line too long for rs274 (long names) is split into one line per axis.
   void EmitPoints() {
     for (const ir::StmtPtr& item : program_.items) {
       const auto* decl = std::get_if<ir::PointDecl>(&item->node);
       if (decl == nullptr) continue;
-      Pose4 root = RootOf(*decl).pose;
-      std::string frame = RootOf(*decl).fixture.empty() ? "robot base" : "fixture " + RootOf(*decl).fixture;
-      Comment(fmt::format("{}Point {} = XY[{}; {}; {}; {}]{}{} -> {} frame", decl->taught ? "Taught " : "",
-                          Quoted(decl->name), Num(decl->coords.values[0]), Num(decl->coords.values[1]),
-                          Num(decl->coords.values[2]), Num(decl->coords.values[3]),
-                          decl->frame.empty() ? "" : decl->taught ? " On " : " In ", Quoted(decl->frame),
-                          Quoted(frame)),
-              item->loc);
-      static constexpr std::array<char, 4> kAxes = {'x', 'y', 'z', 'u'};
+      const RootedPose rooted = RootOf(*decl);
+      const std::array<std::string, 4> params = PointParams(decl->name);
+      std::string& out = out_.buffer();
+      const std::size_t begin = out.size();
       for (int a = 0; a < 4; ++a) {
-        Line(fmt::format("{} = {}", PointParam(decl->name, kAxes[a]), Num(RoundForProgramText(root[a]))), item->loc);
+        if (a > 0) out += ' ';
+        out += params[a];
+        out += " = ";
+        AppendLinuxCncNumber(out, RoundForProgramText(rooted.pose[a]));
       }
+      // Names are identifiers: nothing in them needs sanitizing.
+      std::string what = decl->taught ? "Taught Point " : "Point ";
+      what += Quoted(decl->name);
+      if (!decl->frame.empty()) {
+        what += decl->taught ? " On " : " In ";
+        what += Quoted(decl->frame);
+      }
+      what += rooted.fixture.empty() ? " -> robot base frame" : " -> fixture " + Quoted(rooted.fixture) + " frame";
+      out += " (";
+      AppendWhere(out, item->loc);
+      out += ' ';
+      out += what;
+      out += ")\n";
+      if (out.size() - begin - 1 <= kMaxLineChars) {
+        out_.Produced();
+        continue;
+      }
+      out.resize(begin);  // too long for rs274 (long names): one line per axis
+      Comment(what, item->loc);
+      for (int a = 0; a < 4; ++a) Line(fmt::format("{} = {}", params[a], Num(RoundForProgramText(rooted.pose[a]))), item->loc);
     }
   }
 
@@ -337,6 +414,11 @@ class Emitter {
 
   static std::string PointParam(std::string_view name, char axis) {
     return fmt::format("#<_p_{}_{}>", Lower(name), axis);
+  }
+  // The four parameters of a point: #<_p_NAME_x>, ..._y>, ..._z>, ..._u>.
+  static std::array<std::string, 4> PointParams(std::string_view name) {
+    std::string prefix = "#<_p_" + Lower(name) + "_";
+    return {prefix + "x>", prefix + "y>", prefix + "z>", prefix + "u>"};
   }
 
   void EmitGlobals() {
@@ -603,12 +685,13 @@ class Emitter {
     if (const auto* coords = std::get_if<ir::Coords>(&point.base)) {
       for (int a = 0; a < 4; ++a) position.xyzu[a] = Num(coords->values[a]);
     } else if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
-      static constexpr std::array<char, 4> kAxes = {'x', 'y', 'z', 'u'};
-      for (int a = 0; a < 4; ++a) position.xyzu[a] = PointParam(named->name, kAxes[a]);
-      const sema::Symbol* symbol = symbols_.Find(named->name);
-      SMTCAL_CHECK(symbol != nullptr && symbol->kind == sema::SymbolKind::Point, "a checked target names a point");
-      const auto& decl = std::get<ir::PointDecl>(symbol->decl->node);
-      if (!decl.taught) frame = decl.frame;
+      position.xyzu = PointParams(named->name);
+      if (!point.offsets.empty()) {  // the frame is needed for the offsets only
+        const sema::Symbol* symbol = symbols_.Find(named->name);
+        SMTCAL_CHECK(symbol != nullptr && symbol->kind == sema::SymbolKind::Point, "a checked target names a point");
+        const auto& decl = std::get<ir::PointDecl>(symbol->decl->node);
+        if (!decl.taught) frame = decl.frame;
+      }
     } else {
       position = PalletSlot(std::get<ir::PalletPoint>(point.base), loc, frame);
     }
@@ -718,32 +801,96 @@ class Emitter {
     }
   }
 
-  // Jump there, switch the vacuum, and wait for the sensor to agree; a
-  // timeout aborts naming the statement.
+  // One call of o<pick_place> (EmitPickPlaceSubroutine): the position as
+  // written (static and uncorrected targets: the IR's nominal XY) or as
+  // computed at run time, and how the subroutine corrects it.
   void EmitPickPlace(const ir::Stmt& stmt, const ir::PickPlace& pick) {
     ReadSwitches(stmt);
-    Position target = Commanded(stmt, pick.target);
-    EmitJump(stmt, target, pick.limz.get());
-    bool picking = pick.kind == ir::PickPlaceKind::Pick;
+    int fixture = -1;
+    Command command = CommandOf(stmt, pick.target, &fixture);
+    Position target = PositionOf(pick.target, stmt.loc);
+    if (command != Command::kFixture) fixture = command == Command::kRunTimeBase ? kPickPlaceBase : kPickPlaceAsWritten;
+    if (safe_limz_.empty()) safe_limz_ = Num(cell_.robot.safe_limz_mm);
+    GExpr limz = pick.limz ? Expr(*pick.limz) : safe_limz_;
     GExpr vacuum = pick.vacuum ? Expr(*pick.vacuum) : Num(DefaultVacuum());
-    Line(fmt::format("{} P{}", picking ? "M64" : "M65", vacuum), stmt.loc);
-    Line(fmt::format("M66 P{} L{} Q{}", linuxcnc_->vacuum_sensor_input, picking ? 3 : 4,
-                     Num(linuxcnc_->vacuum_timeout_s)), stmt.loc);
-    int o = NextOWord();
-    Line(fmt::format("o{} if [#5399 LT 0]", o), stmt.loc);
-    ++indent_;
-    Abort(fmt::format("{} of {}: vacuum sensor input {} did not report {} within {} s", picking ? "Pick" : "Place",
-                      Quoted(TargetText(stmt, pick.target)), linuxcnc_->vacuum_sensor_input,
-                      picking ? "the part held" : "the part released", Num(linuxcnc_->vacuum_timeout_s)),
-          stmt.loc);
-    --indent_;
-    Line(fmt::format("o{} endif", o), stmt.loc);
+    std::string& out = Begin();
+    const std::size_t begin = out.size();
+    auto argument = [&](std::string_view text) {
+      out += " [";
+      out += text;
+      out += ']';
+    };
+    char digits[16];
+    out += "o<pick_place> call";
+    argument(std::string_view(digits, std::to_chars(digits, digits + sizeof digits, fixture).ptr));
+    for (const GExpr& axis : target.xyzu) argument(axis);
+    argument(limz);
+    argument(vacuum);
+    argument(pick.kind == ir::PickPlaceKind::Pick ? "1" : "0");
+    argument(std::string_view(digits, std::to_chars(digits, digits + sizeof digits, stmt.loc.line).ptr));
+    out += Suffix(stmt.loc);
+    Ended(begin, stmt.loc);
   }
 
-  // The target as the source wrote it (static targets' IR holds the nominal XY).
-  std::string TargetText(const ir::Stmt& stmt, const ir::PointExpr& point) const {
-    auto it = target_text_.find(&stmt);
-    return it != target_text_.end() ? it->second : PrintPointText(point);
+  // o<pick_place> call [fixture] [x] [y] [z] [u] [LimZ] [vacuum] [1: Pick, 0: Place] [source line]:
+  // the target corrected on the controller (fixture: the cell's index of the
+  // fixture it is in, or kPickPlaceBase: a base position, through the error
+  // tables; kPickPlaceAsWritten: commanded as given), the Jump there, the
+  // vacuum switched, and the sensor waited for; a timeout aborts naming the
+  // source line. One subroutine in the main program, so each Pick and Place
+  // is one line of it, as a controller reads it.
+  void EmitPickPlaceSubroutine() {
+    bool used = false;
+    ir::ForEachStmt(program_.items, [&](const ir::Stmt& stmt) {
+      used = used || std::holds_alternative<ir::PickPlace>(stmt.node);
+    });
+    if (!used) return;
+    const std::string timeout = Num(linuxcnc_->vacuum_timeout_s);
+    const int sensor = linuxcnc_->vacuum_sensor_input;
+    const std::string where = SanitizeMessage(Quoted(source_name_));
+    const char axis = linuxcnc_->rotation_axis;
+    auto block = [&](std::string_view text) { out_.Append(fmt::format("{}{}\n", std::string(static_cast<std::size_t>(indent_) * 2, ' '), text)); };
+    Comment(fmt::format("Pick and Place: o<pick_place> call [fixture] [x] [y] [z] [u] [LimZ] [vacuum] [1 Pick or 0 Place] [source line]"));
+    Comment(fmt::format("fixture: the cell's index of the fixture - {}: a base position corrected through the tables - {}: as given",
+                        kPickPlaceBase, kPickPlaceAsWritten));
+    block("o<pick_place> sub");
+    ++indent_;
+    block(fmt::format("o<pick_place_correct> if [#1 GT {}]", kPickPlaceAsWritten));
+    ++indent_;
+    block("o<smtcal_correct> call [#1] [#2] [#3]");
+    block("#2 = #<_smtcal_x>");
+    block("#3 = #<_smtcal_y>");
+    block("#5 = [#5 + #<_smtcal_angle>]");
+    --indent_;
+    block("o<pick_place_correct> endif");
+    block("G0 Z#6");
+    block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    block("G0 Z#4");
+    block("o<pick_place_vacuum> if [#8 EQ 1]");
+    ++indent_;
+    block("M64 P#7");
+    block(fmt::format("M66 P{} L3 Q{}", sensor, timeout));
+    --indent_;
+    block("o<pick_place_vacuum> else");
+    ++indent_;
+    block("M65 P#7");
+    block(fmt::format("M66 P{} L4 Q{}", sensor, timeout));
+    --indent_;
+    block("o<pick_place_vacuum> endif");
+    block("o<pick_place_agreed> if [#5399 LT 0]");
+    ++indent_;
+    block("o<pick_place_held> if [#8 EQ 1]");
+    ++indent_;
+    block(fmt::format("(abort, smtcal: Pick at {}:%d#9: vacuum sensor input {} did not report the part held within {} s)",
+                      where, sensor, timeout));
+    --indent_;
+    block("o<pick_place_held> endif");
+    block(fmt::format("(abort, smtcal: Place at {}:%d#9: vacuum sensor input {} did not report the part released within {} s)",
+                      where, sensor, timeout));
+    --indent_;
+    block("o<pick_place_agreed> endif");
+    --indent_;
+    block("o<pick_place> endsub");
   }
 
   double DefaultVacuum() const {
@@ -755,16 +902,21 @@ class Emitter {
   const CompileState& state_;
   const cell::Cell& cell_;
   const cell::LinuxCnc* linuxcnc_ = nullptr;
-  sema::SymbolTable symbols_;
+  const sema::SymbolTable& symbols_;
   std::string source_name_;
   Diagnostics& diags_;
-  std::map<const ir::Stmt*, bool> as_written_;
-  std::map<const ir::Stmt*, std::string> target_text_;  // the first target's text
+  std::unordered_map<const ir::Stmt*, bool> as_written_;
+  std::unordered_map<const sema::Symbol*, int> cell_fixture_of_;  // FixtureIndexOf's answers
+  std::string safe_limz_;  // the robot's safe_limz_mm, as written
   std::optional<int> default_vacuum_;                   // the program's `Vacuum n`
   std::map<const ir::Expr*, std::string> switches_;
   std::set<std::string> locals_;  // the current function's, lowercase
   std::string function_;          // the current function, lowercase
-  std::string out_;
+  TextOutput& out_;
+  std::string suffix_;            // Suffix() of source line suffix_line_
+  std::string source_where_;      // "layers.place:", sanitized
+  std::uint32_t suffix_line_ = 0;
+  bool suffix_made_ = false;
   int indent_ = 0;
   int next_oword_ = kFirstOWord;
   int next_switch_ = 1;
@@ -807,17 +959,6 @@ Status WriteText(const fs::path& path, const std::string& text) {
   return Ok{};
 }
 
-Status WriteTree(const fs::path& dir, const LinuxCncOutput& output) {
-  std::error_code error;
-  fs::create_directories(dir / "subroutines", error);
-  if (error) return Error{fmt::format("cannot create '{}': {}", dir.string(), error.message())};
-  if (Status written = WriteText(dir / output.main_name, output.main_text); !written) return written;
-  for (const EmbeddedFile& file : output.subroutines) {
-    if (Status written = WriteText(dir / "subroutines" / file.name, file.text); !written) return written;
-  }
-  return Ok{};
-}
-
 }  // namespace
 
 std::string LinuxCncMainName(const std::string& program_path) {
@@ -829,7 +970,7 @@ std::string LinuxCncMainName(const std::string& program_path) {
 }
 
 std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const CompileState& state,
-                                           const std::string& program_path, Diagnostics& diags) {
+                                           const std::string& program_path, TextOutput& main, Diagnostics& diags) {
   SMTCAL_CHECK(state.cell != nullptr, "the linuxcnc target needs a compiled program");
   const cell::Cell& cell = *state.cell;
   if (std::optional<std::string> problem = LinuxCncDataProblem(cell)) {
@@ -845,11 +986,9 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
     return std::nullopt;
   }
   std::string source_name = program_path == "-" ? "stdin" : fs::path(program_path).filename().string();
-  std::optional<std::string> main = Emitter(program, state, source_name, diags).Run();
-  if (!main) return std::nullopt;
+  if (!Emitter(program, state, source_name, main, diags).Run()) return std::nullopt;
   LinuxCncOutput output;
   output.main_name = LinuxCncMainName(program_path);
-  output.main_text = std::move(*main);
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
@@ -857,47 +996,66 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   return output;
 }
 
-std::string LinuxCncReviewText(const LinuxCncOutput& output) {
-  std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, output.main_text);
+std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view main_text) {
+  std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, main_text);
   for (const EmbeddedFile& file : output.subroutines) {
     if (file.name == "smtcal_data.ngc") text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
   }
   return text;
 }
 
-Status WriteLinuxCncDirectory(const fs::path& outdir, const LinuxCncOutput& output) {
-  fs::path target = outdir.has_filename() ? outdir : outdir.parent_path();
+Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::path& outdir,
+                                                                   const std::string& main_name) {
+  auto directory = std::unique_ptr<LinuxCncDirectory>(new LinuxCncDirectory());
+  LinuxCncDirectory& d = *directory;
+  d.target_ = outdir.has_filename() ? outdir : outdir.parent_path();
   std::error_code error;
-  bool exists = fs::exists(fs::symlink_status(target, error));
-  if (exists) {
-    if (std::string why = NotOurOutput(target); !why.empty()) {
+  d.replaces_ = fs::exists(fs::symlink_status(d.target_, error));
+  if (d.replaces_) {
+    if (std::string why = NotOurOutput(d.target_); !why.empty()) {
       return Error{fmt::format("will not replace '{}': {}; choose another -o directory or remove it",
-                               target.string(), why)};
+                               d.target_.string(), why)};
     }
   }
-  fs::path temp = target;
-  temp += fmt::format(".tmp.{}", ::getpid());
-  fs::remove_all(temp, error);
-  if (Status written = WriteTree(temp, output); !written) {
-    fs::remove_all(temp, error);
-    return written;
+  d.temp_ = d.target_;
+  d.temp_ += fmt::format(".tmp.{}", ::getpid());
+  fs::remove_all(d.temp_, error);
+  fs::create_directories(d.temp_ / "subroutines", error);
+  if (error) return Error{fmt::format("cannot create '{}': {}", d.temp_.string(), error.message())};
+  Result<std::unique_ptr<TextOutput>> main = TextOutput::Open((d.temp_ / main_name).string());
+  if (!main) return main.error();
+  d.main_ = std::move(main).value();
+  return directory;
+}
+
+LinuxCncDirectory::~LinuxCncDirectory() {
+  main_.reset();  // closes and removes an unfinished main program first
+  std::error_code error;
+  if (!committed_) fs::remove_all(temp_, error);
+}
+
+Status LinuxCncDirectory::Commit(const LinuxCncOutput& output) {
+  std::error_code error;
+  Status written = main_->Commit();
+  for (const EmbeddedFile& file : output.subroutines) {
+    if (!written) break;
+    written = WriteText(temp_ / "subroutines" / file.name, file.text);
   }
-  if (!exists) {
-    if (std::rename(temp.c_str(), target.c_str()) != 0) {
-      int saved = errno;
-      fs::remove_all(temp, error);
-      return Error{fmt::format("cannot write '{}': {}", target.string(), std::strerror(saved))};
+  if (!written) return written;
+  if (!replaces_) {
+    if (std::rename(temp_.c_str(), target_.c_str()) != 0) {
+      return Error{fmt::format("cannot write '{}': {}", target_.string(), std::strerror(errno))};
     }
+    committed_ = true;
     return Ok{};
   }
   // Swap the finished directory in atomically; the old one leaves under the
   // temporary's name and is removed.
-  if (::renameat2(AT_FDCWD, temp.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0) {
-    int saved = errno;
-    fs::remove_all(temp, error);
-    return Error{fmt::format("cannot replace '{}': {}", target.string(), std::strerror(saved))};
+  if (::renameat2(AT_FDCWD, temp_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) != 0) {
+    return Error{fmt::format("cannot replace '{}': {}", target_.string(), std::strerror(errno))};
   }
-  fs::remove_all(temp, error);
+  fs::remove_all(temp_, error);
+  committed_ = true;
   return Ok{};
 }
 

@@ -10,33 +10,38 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "backend/linuxcnc/embedded_files.h"
 #include "base/diagnostics.h"
 #include "base/result.h"
 #include "base/source.h"
+#include "base/text_output.h"
 #include "ir/ir.h"
 #include "passes/correction/compile_state.h"
 
 namespace smtcal {
 
-// What one compile writes: the main program and the subroutine files.
+// What one compile writes besides the main program's text: its file name
+// and the subroutine files.
 struct LinuxCncOutput {
   std::string main_name;                  // "<program file stem>.ngc"
-  std::string main_text;
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
 };
 
-// Lowers the program. What the target cannot express (a cell without a
-// [linuxcnc] table, data the runtime cannot hold, an I/O bit LinuxCNC does
-// not have, a pallet number known only at run time) is reported to `diags`
-// and gives nullopt. `program_path` names the source in the output's
-// comments (its file name only).
+// Lowers the program, writing the main program's text to `main` as it is
+// produced. What the target cannot express (a cell without a [linuxcnc]
+// table, data the runtime cannot hold, an I/O bit LinuxCNC does not have, a
+// pallet number known only at run time, a line too long for rs274) is
+// reported to `diags`; nullopt, or errors in `diags`, leave `main`
+// incomplete: never commit it then. `program_path` names the source in the
+// output's comments (its file name only).
 std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const CompileState& state,
-                                           const std::string& program_path, Diagnostics& diags);
+                                           const std::string& program_path, TextOutput& main, Diagnostics& diags);
 
 // The name of the main program file for a source path: "layers.place" ->
 // "layers.ngc" ("-" -> "program.ngc").
@@ -45,14 +50,36 @@ std::string LinuxCncMainName(const std::string& program_path);
 // Every generated file for review on one stream: the main program, then
 // smtcal_data.ngc, each after a "(smtcal file: PATH)" line. The runtime's
 // own files are not repeated (they are runtime/linuxcnc/*.ngc verbatim).
-std::string LinuxCncReviewText(const LinuxCncOutput& output);
+std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view main_text);
 
-// Writes the output directory: OUTDIR/<main_name> and OUTDIR/subroutines/*.
-// Everything is written into a temporary sibling directory first and then
-// swapped in by a rename, so OUTDIR is never half-written. An existing OUTDIR
-// is replaced only when it is an earlier smtcal output (its .ngc files open
-// with smtcal's header line, subroutines/ holds only smtcal_*.ngc);
-// anything else is refused with an Error naming what is in the way.
-Status WriteLinuxCncDirectory(const std::filesystem::path& outdir, const LinuxCncOutput& output);
+// The output directory OUTDIR: OUTDIR/<main_name> and OUTDIR/subroutines/*,
+// written into a temporary sibling (OUTDIR.tmp.PID) and swapped in by a
+// rename at Commit(), so OUTDIR is never half-written; a directory never
+// committed leaves nothing behind. An existing OUTDIR is replaced only when
+// it is an earlier smtcal output (its .ngc files open with smtcal's header
+// line, subroutines/ holds only smtcal_*.ngc); anything else is refused by
+// Open() with an Error naming what is in the way.
+class LinuxCncDirectory {
+ public:
+  static Result<std::unique_ptr<LinuxCncDirectory>> Open(const std::filesystem::path& outdir,
+                                                        const std::string& main_name);
+  ~LinuxCncDirectory();
+  LinuxCncDirectory(const LinuxCncDirectory&) = delete;
+  LinuxCncDirectory& operator=(const LinuxCncDirectory&) = delete;
+
+  // The main program's file, written as EmitLinuxCnc produces it.
+  TextOutput& main() { return *main_; }
+  // Completes the main program, writes the subroutines and swaps the
+  // directory in.
+  Status Commit(const LinuxCncOutput& output);
+
+ private:
+  LinuxCncDirectory() = default;
+  std::filesystem::path target_;
+  std::filesystem::path temp_;
+  bool replaces_ = false;  // OUTDIR exists (an earlier output)
+  bool committed_ = false;
+  std::unique_ptr<TextOutput> main_;
+};
 
 }  // namespace smtcal

@@ -15,10 +15,8 @@ namespace {
 
 class Printer {
  public:
-  std::string Print(const ir::Program& program) {
-    PrintBlock(program.items, 0);
-    return std::move(out_);
-  }
+  explicit Printer(TextOutput& out) : output_(out), out_(out.buffer()) {}
+  void Print(const ir::Program& program) { PrintBlock(program.items, 0); }
 
  private:
   // One output line: indentation, text, and the comment written on it.
@@ -27,6 +25,7 @@ class Printer {
     out_ += text;
     out_ += comment;
     out_ += '\n';
+    output_.Produced();
   }
 
   // "  'text" for a trailing comment; nothing when there is none. The IR
@@ -157,12 +156,26 @@ class Printer {
         stmt.node);
   }
 
-  std::string out_;
+  TextOutput& output_;
+  std::string& out_;  // output_'s buffer
 };
 
 }  // namespace
 
-std::string PrintPlace(const ir::Program& program) { return Printer().Print(program); }
+void PrintPlace(const ir::Program& program, TextOutput& out) { Printer(out).Print(program); }
+
+std::string PrintPlace(const ir::Program& program) {
+  TextOutput out;
+  PrintPlace(program, out);
+  return std::move(out.buffer());
+}
+
+Status WritePlace(const std::string& path, const ir::Program& program) {
+  Result<std::unique_ptr<TextOutput>> out = TextOutput::Open(path);
+  if (!out) return out.error();
+  PrintPlace(program, *out.value());
+  return out.value()->Commit();
+}
 
 namespace {
 

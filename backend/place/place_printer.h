@@ -7,6 +7,8 @@
 
 #include <string>
 
+#include "base/result.h"
+#include "base/text_output.h"
 #include "ir/ir.h"
 #include "ir/ir_text.h"  // the expressions and literals inside a program
 
@@ -15,6 +17,12 @@ namespace smtcal {
 // The whole program in canonical form: every line ends with '\n', an empty
 // program prints as "".
 std::string PrintPlace(const ir::Program& program);
+// The same appended to `out` as it is produced (a large program is never
+// held as one string)...
+void PrintPlace(const ir::Program& program, TextOutput& out);
+// ... and written to the file `path` ("-": standard output) that way,
+// atomically (base/text_output.h).
+Status WritePlace(const std::string& path, const ir::Program& program);
 
 // What printing changes on purpose, done to an IR: a `Next` that is bare or
 // spells its loop variable differently gets the For's spelling, and the first

@@ -64,7 +64,7 @@ class CheckFixtureScope final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& table = sema::SymbolsOf(program);
     table_ = &table;
 
     std::vector<const ir::Function*> functions;

@@ -63,7 +63,7 @@ class CheckNames final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& table = sema::SymbolsOf(program);
     table_ = &table;
     for (const ir::StmtPtr& item : program.items) TopLevel(*item);
   }

@@ -29,7 +29,7 @@ class CheckRanges final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& table = sema::SymbolsOf(program);
     table_ = &table;
     for (const ir::StmtPtr& item : program.items) {
       if (std::holds_alternative<ir::VacuumDecl>(item->node)) has_default_vacuum_ = true;

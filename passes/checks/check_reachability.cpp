@@ -45,7 +45,7 @@ class CheckReachability final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& table = sema::SymbolsOf(program);
     table_ = &table;
     std::vector<const ir::Stmt*> functions;
     for (const ir::StmtPtr& item : program.items) {

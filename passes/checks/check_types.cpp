@@ -49,7 +49,7 @@ class CheckTypes final : public Pass {
 
   void Run(ir::Program& program, Diagnostics& diags) override {
     diags_ = &diags;
-    sema::SymbolTable table = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& table = sema::SymbolsOf(program);
     for (const ir::StmtPtr& item : program.items) {
       const auto* function = std::get_if<ir::Function>(&item->node);
       if (function == nullptr) continue;

@@ -30,7 +30,7 @@ class Bind final : public Pass {
                  "bind runs only when compiling for a cell");
     CompileState& state = *program.compile;
     const cell::Cell& cell = *state.cell;
-    sema::SymbolTable symbols = sema::SymbolTable::Build(program);
+    const sema::SymbolTable& symbols = sema::SymbolsOf(program);
 
     for (const ir::StmtPtr& item : program.items) {
       if (const auto* fixture = std::get_if<ir::FixtureDecl>(&item->node)) BindFixture(*item, *fixture, cell, state, diags);

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <algorithm>
@@ -243,6 +244,42 @@ TEST(LinuxCncData, NumbersArePlainDecimalsThatReadBackExactly) {
   for (int i = 0; i < 1000; ++i) {
     const double v = Uniform(rng, -1000, 1000) * std::pow(10.0, std::uniform_int_distribution<int>(-8, 3)(rng));
     EXPECT_EQ(std::strtod(LinuxCncNumber(v).c_str(), nullptr), v);
+  }
+}
+
+// The fewest decimals that read back, correctly rounded: printf's %.Nf for
+// N = 0, 1, ... until strtod gives the value back. LinuxCncNumber computes
+// it faster (std::to_chars); this is its definition.
+std::string FewestDecimalsReference(double value) {
+  if (value == 0) return "0";
+  for (int digits = 0;; ++digits) {
+    std::string text = fmt::format("{:.{}f}", value, digits);
+    if (std::strtod(text.c_str(), nullptr) == value) return text;
+  }
+}
+
+TEST(LinuxCncData, NumbersAreTheFewestDecimalsCorrectlyRounded) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {}", seed));
+  std::mt19937_64 rng(seed);
+  std::vector<double> values = {1.0, 0.5, 0.25, 1024.0, 0x1p-20, 0x1p52, 0x1p53, 0x1p53 + 2, 0x1p60, 1e22, 1e23,
+                                123456789012345680000.0, 4503599627370495.5, 2251799813685247.75, 0.1, 0.3,
+                                1e-300, 5e-324, 1.7976931348623157e308, 160.0561725519, 9.9521064565};
+  for (int i = 0; i < 10000; ++i) {
+    // Coordinates and table values as smtcal writes them, and any double.
+    const double coordinate = std::round(Uniform(rng, -1000, 1000) * 1e10) / 1e10;
+    const double scaled = Uniform(rng, -1, 1) * std::pow(10.0, std::uniform_int_distribution<int>(-12, 18)(rng));
+    const double power = std::ldexp(1.0, std::uniform_int_distribution<int>(-60, 70)(rng));
+    std::uint64_t bits = rng();
+    double any = 0;
+    std::memcpy(&any, &bits, sizeof any);
+    values.insert(values.end(), {coordinate, scaled, power, -power, std::nextafter(power, 0.0),
+                                 std::nextafter(power, 1e300)});
+    if (std::isfinite(any) && std::abs(any) > 1e-20 && std::abs(any) < 1e60) values.push_back(any);
+  }
+  for (double v : values) {
+    ASSERT_EQ(LinuxCncNumber(v), FewestDecimalsReference(v)) << fmt::format("{:.17g}", v);
+    ASSERT_EQ(LinuxCncNumber(-v), FewestDecimalsReference(-v)) << fmt::format("{:.17g}", -v);
   }
 }
 
