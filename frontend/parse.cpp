@@ -695,26 +695,33 @@ class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
   }
 
  private:
-  void Set(const PlaceToken& from, std::size_t type) {
-    if (size_ == tokens_.size()) {
-      tokens_.push_back(std::make_unique<antlr4::CommonToken>(
-          std::pair<antlr4::TokenSource*, antlr4::CharStream*>(this, nullptr), Token::INVALID_TYPE,
-          Token::DEFAULT_CHANNEL, 0, 0));
+  // A CommonToken filled in place for each line (its setters are virtual
+  // calls, one per field).
+  class Reused : public antlr4::CommonToken {
+   public:
+    explicit Reused(antlr4::TokenSource* source)
+        : antlr4::CommonToken(std::pair<antlr4::TokenSource*, antlr4::CharStream*>(source, nullptr),
+                              Token::INVALID_TYPE, Token::DEFAULT_CHANNEL, 0, 0) {}
+    void Fill(const PlaceToken& from, std::size_t type, std::size_t index) {
+      _type = type;
+      _line = from.line;
+      _charPositionInLine = from.column;
+      // A token of no length (the end of file, a NEWLINE made up there)
+      // stops where it starts, beyond the text: its text is empty.
+      _start = from.start;
+      _stop = from.length == 0 ? from.start : from.start + from.length - 1;
+      _index = index;
     }
-    antlr4::CommonToken& token = *tokens_[size_];
-    token.setType(type);
-    // A token of no length (the end of file, a NEWLINE made up there) stops
-    // where it starts, beyond the text: its text is empty.
-    token.setStartIndex(from.start);
-    token.setStopIndex(from.length == 0 ? from.start : from.start + from.length - 1);
-    token.setLine(from.line);
-    token.setCharPositionInLine(from.column);
-    token.setTokenIndex(size_);
+  };
+
+  void Set(const PlaceToken& from, std::size_t type) {
+    if (size_ == tokens_.size()) tokens_.push_back(std::make_unique<Reused>(this));
+    tokens_[size_]->Fill(from, type, size_);
     ++size_;
   }
 
   const Session& session_;
-  std::vector<std::unique_ptr<antlr4::CommonToken>> tokens_;  // [0, size_) are this line's
+  std::vector<std::unique_ptr<Reused>> tokens_;  // [0, size_) are this line's
   std::size_t size_ = 0;
   std::size_t p_ = 0;
 };
@@ -891,9 +898,7 @@ void Session::ReportParseError(antlr4::Parser* parser, antlr4::ParserRuleContext
 
   if (auto* coords = Find<P::CoordsContext>(ctx)) {
     std::size_t numbers = 0;
-    for (P::SignedNumberContext* number : {coords->x, coords->y, coords->z, coords->u}) {
-      numbers += number != nullptr && number->value != nullptr ? 1 : 0;
-    }
+    for (const Token* number : {coords->x, coords->y, coords->z, coords->u}) numbers += number != nullptr ? 1 : 0;
     if (has(P::NUMBER) && type != P::RPAREN && !at_end) {
       Error(DiagKind::CoordsNotNumber, at, found_text);
       return;
@@ -999,24 +1004,22 @@ class IrBuilder {
   // ... or a closer the pre-scan added at the position of the token `at`.
   ir::BlockEnd End(const PlaceToken& at) const { return ir::BlockEnd{s_.Loc(at), CommentOn(at.line)}; }
 
-  // declaration : programDecl | unitsDecl | fixtureDecl | localDecl | pointDecl
-  //             | palletDecl | vacuumDecl | varDecl ;
-  ir::StmtPtr Declaration(P::DeclarationContext* ctx) {
-    if (ctx == nullptr) return nullptr;
+  // declarationLine : (programDecl | unitsDecl | fixtureDecl | localDecl | pointDecl
+  //                    | palletDecl | vacuumDecl | varDecl) NEWLINE ;
+  ir::StmtPtr Declaration(P::DeclarationLineContext* ctx) {
+    if (ctx->pointAlt != nullptr) return PointDecl(ctx->pointAlt);
     if (ctx->programAlt != nullptr) return ProgramDecl(ctx->programAlt);
     if (ctx->unitsAlt != nullptr) return UnitsDecl(ctx->unitsAlt);
     if (ctx->fixtureAlt != nullptr) return FixtureDecl(ctx->fixtureAlt);
     if (ctx->localAlt != nullptr) return LocalDecl(ctx->localAlt);
-    if (ctx->pointAlt != nullptr) return PointDecl(ctx->pointAlt);
     if (ctx->palletAlt != nullptr) return PalletDecl(ctx->palletAlt);
     if (ctx->vacuumAlt != nullptr) return VacuumDecl(ctx->vacuumAlt);
     if (ctx->varDeclAlt != nullptr) return VarDecl(ctx->varDeclAlt);
     return nullptr;
   }
-  // statement : varDecl | assignment | motion | pickPlace | onOff | waitStmt
-  //           | callStmt | scanStmt | exitStmt ;
-  ir::StmtPtr Statement(P::StatementContext* ctx) {
-    if (ctx == nullptr) return nullptr;
+  // statementLine : (varDecl | assignment | motion | pickPlace | onOff | waitStmt
+  //                  | callStmt | scanStmt | exitStmt) NEWLINE ;
+  ir::StmtPtr Statement(P::StatementLineContext* ctx) {
     if (ctx->pickPlaceAlt != nullptr) return PickPlace(ctx->pickPlaceAlt);
     if (ctx->motionAlt != nullptr) return Motion(ctx->motionAlt);
     if (ctx->assignmentAlt != nullptr) return Assignment(ctx->assignmentAlt);
@@ -1121,20 +1124,19 @@ class IrBuilder {
     }
     return static_cast<int>(lit.value);
   }
-  // coords : XY '(' x=signedNumber ',' y=signedNumber ',' z=signedNumber ',' u=signedNumber ')' ;
-  // signedNumber : sign=('-' | '+')? value=NUMBER ;
+  // coords : XY '(' xSign=('-' | '+')? x=NUMBER ',' ... uSign=('-' | '+')? u=NUMBER ')' ;
   std::optional<ir::Coords> Coords(P::CoordsContext* ctx) {
     if (ctx == nullptr) return std::nullopt;
-    const std::array<P::SignedNumberContext*, 4> numbers = {ctx->x, ctx->y, ctx->z, ctx->u};
-    for (P::SignedNumberContext* number : numbers) {
+    const std::array<Token*, 4> numbers = {ctx->x, ctx->y, ctx->z, ctx->u};
+    const std::array<Token*, 4> signs = {ctx->xSign, ctx->ySign, ctx->zSign, ctx->uSign};
+    for (const Token* number : numbers) {
       if (number == nullptr) return std::nullopt;
     }
     ir::Coords coords;
     coords.loc = s_.Loc(ctx->getStart());
     for (std::size_t i = 0; i < 4; ++i) {
-      double value = Number(numbers[i]->value).value;
-      bool negative = numbers[i]->sign != nullptr && numbers[i]->sign->getType() == P::MINUS;
-      coords.values[i] = negative ? -value : value;
+      double value = Number(numbers[i]).value;
+      coords.values[i] = signs[i] != nullptr && signs[i]->getType() == P::MINUS ? -value : value;
     }
     return coords;
   }
@@ -1674,10 +1676,10 @@ ir::Program Session::Run() {
         default:
           if (blocks.AtTopLevel()) {
             P::DeclarationLineContext* decl = parser.Parse(line, &PlaceParser::declarationLine);
-            blocks.Statement(n, [&] { return ir.Declaration(decl->item); });
+            blocks.Statement(n, [&] { return ir.Declaration(decl); });
           } else {
             P::StatementLineContext* stmt = parser.Parse(line, &PlaceParser::statementLine);
-            blocks.Statement(n, [&] { return ir.Statement(stmt->item); });
+            blocks.Statement(n, [&] { return ir.Statement(stmt); });
           }
       }
     }

@@ -16,9 +16,29 @@ grammar Place;
 // never abandons the block around it. Every line rule ends in the line's
 // NEWLINE: parse.cpp gives each line one (also a last line that lacks it).
 // parse.cpp reads the elements it needs through their labels only: it does
-// not have ANTLR build the children lists of the parse tree.
-declarationLine : item=declaration NEWLINE ;
-statementLine   : item=statement NEWLINE ;
+// not have ANTLR build the children lists of the parse tree. The kinds of
+// declaration and statement are alternatives of their line's rule, not a
+// rule of their own: each rule level costs the parser about as much as a
+// token does.
+declarationLine : ( programAlt=programDecl
+                  | unitsAlt=unitsDecl
+                  | fixtureAlt=fixtureDecl
+                  | localAlt=localDecl
+                  | pointAlt=pointDecl
+                  | palletAlt=palletDecl
+                  | vacuumAlt=vacuumDecl
+                  | varDeclAlt=varDecl
+                  ) NEWLINE ;
+statementLine   : ( varDeclAlt=varDecl
+                  | assignmentAlt=assignment
+                  | motionAlt=motion
+                  | pickPlaceAlt=pickPlace
+                  | onOffAlt=onOff
+                  | waitAlt=waitStmt
+                  | callAlt=callStmt
+                  | scanAlt=scanStmt
+                  | exitAlt=exitStmt
+                  ) NEWLINE ;
 // The lines that open and close blocks.
 functionHead: FUNCTION name=ID ('(' ')')? NEWLINE ;
 forHead     : FOR var=ID '=' from=expr TO to=expr (STEP step=expr)? NEWLINE ;
@@ -32,18 +52,6 @@ endIfLine   : ENDIF NEWLINE ;
 endCycleLine: ENDCYCLE NEWLINE ;
 
 // ---------------------------------------------------------------- declarations
-// The labels (here and in statement) name the alternative's context, so
-// parse.cpp reaches it without a search through the children.
-declaration : programAlt=programDecl
-            | unitsAlt=unitsDecl
-            | fixtureAlt=fixtureDecl
-            | localAlt=localDecl
-            | pointAlt=pointDecl
-            | palletAlt=palletDecl
-            | vacuumAlt=vacuumDecl
-            | varDeclAlt=varDecl
-            ;
-
 programDecl : PROGRAM name=ID ;
 unitsDecl   : UNITS unit=ID ;
 fixtureDecl : FIXTURE name=ID ;
@@ -53,21 +61,12 @@ palletDecl  : PALLET number=NUMBER ',' corner1=ID ',' corner2=ID ',' corner3=ID 
 vacuumDecl  : VACUUM output=NUMBER ;
 varDecl     : type=(INTEGER | REAL) names+=ID (',' names+=ID)* ;
 
-coords      : XY '(' x=signedNumber ',' y=signedNumber ',' z=signedNumber ',' u=signedNumber ')' ;
-signedNumber: sign=('-' | '+')? value=NUMBER ;
+// Four numbers, each with its sign (written out: a rule level per number
+// would cost the parser as much as the whole rest of a point's line).
+coords      : XY '(' xSign=('-' | '+')? x=NUMBER ',' ySign=('-' | '+')? y=NUMBER ','
+                     zSign=('-' | '+')? z=NUMBER ',' uSign=('-' | '+')? u=NUMBER ')' ;
 
 // ---------------------------------------------------------------- statements
-statement   : varDeclAlt=varDecl
-            | assignmentAlt=assignment
-            | motionAlt=motion
-            | pickPlaceAlt=pickPlace
-            | onOffAlt=onOff
-            | waitAlt=waitStmt
-            | callAlt=callStmt
-            | scanAlt=scanStmt
-            | exitAlt=exitStmt
-            ;
-
 assignment  : name=ID '=' value=expr ;
 motion      : kind=(JUMP | GO | MOVE) target=pointExpr (limzKeyword=LIMZ limz=expr)? ;
 pickPlace   : kind=(PICK | PLACE) target=pointExpr (VACUUM vacuum=expr)? (LIMZ limz=expr)? ;
