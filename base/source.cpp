@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -43,10 +44,21 @@ Result<std::uint32_t> SourceManager::Load(const std::string& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error{fmt::format("cannot open '{}': {}", path, std::strerror(errno))};
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
+  // Read in chunks into a string sized for the file up front: a large file is
+  // held once, not twice (a stream buffer and its copy) while it is read.
+  constexpr std::size_t kChunk = std::size_t{1} << 20;
+  std::error_code size_error;
+  std::uintmax_t size = std::filesystem::file_size(path, size_error);
+  if (!size_error) text.reserve(static_cast<std::size_t>(size) + kChunk);
+  for (;;) {
+    const std::size_t read = text.size();
+    text.resize(read + kChunk);
+    in.read(text.data() + read, static_cast<std::streamsize>(kChunk));
+    text.resize(read + static_cast<std::size_t>(in.gcount()));
+    if (!in) break;
+  }
   if (in.bad()) return Error{fmt::format("cannot read '{}': {}", path, std::strerror(errno))};
-  return Add(path, std::move(buffer).str());
+  return Add(path, std::move(text));
 }
 
 const SourceFile& SourceManager::File(std::uint32_t id) const {

@@ -211,8 +211,12 @@ std::string Describe(const OpenBlock& open) {
 
 class Session {
  public:
-  Session(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags)
-      : file_(file), diags_(diags), text_(diags.sources().File(file).text), tokens_(std::move(tokens)) {}
+  Session(std::uint32_t file, LexedPlace lexed, Diagnostics& diags)
+      : file_(file),
+        diags_(diags),
+        text_(diags.sources().File(file).text),
+        tokens_(std::move(lexed.tokens)),
+        line_starts_(std::move(lexed.line_starts)) {}
 
   ir::Program Run();
 
@@ -221,7 +225,8 @@ class Session {
   std::string_view Text(const PlaceToken& token) const {
     return std::string_view(text_).substr(token.start, token.length);
   }
-  SourceLoc Loc(const PlaceToken& token) const { return SourceLoc{file_, token.line, token.column + 1}; }
+  std::uint32_t Column(const PlaceToken& token) const { return token.start - line_starts_[token.line]; }
+  SourceLoc Loc(const PlaceToken& token) const { return SourceLoc{file_, token.line, Column(token) + 1}; }
   std::uint32_t Length(const PlaceToken& token) const { return std::max<std::uint32_t>(1, token.length); }
   SourceRange Range(const PlaceToken& token) const { return SourceRange(Loc(token), Length(token)); }
   // "'Jump'", "end of line" or "end of file": how a found token is named.
@@ -316,6 +321,7 @@ class Session {
   Diagnostics& diags_;
   const std::string& text_;
   std::vector<PlaceToken> tokens_;  // every token the lexer made, EOF last
+  std::vector<std::uint32_t> line_starts_;  // [line]: where it starts
   std::vector<Line> lines_;         // by line number; [0] unused
   std::vector<Closer> closers_;     // the closers before lines, in line order
   std::vector<Closer> closers_at_end_;  // closers added at the end of the file
@@ -702,10 +708,10 @@ class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
     explicit Reused(antlr4::TokenSource* source)
         : antlr4::CommonToken(std::pair<antlr4::TokenSource*, antlr4::CharStream*>(source, nullptr),
                               Token::INVALID_TYPE, Token::DEFAULT_CHANNEL, 0, 0) {}
-    void Fill(const PlaceToken& from, std::size_t type, std::size_t index) {
+    void Fill(const PlaceToken& from, std::uint32_t column, std::size_t type, std::size_t index) {
       _type = type;
       _line = from.line;
-      _charPositionInLine = from.column;
+      _charPositionInLine = column;
       // A token of no length (the end of file, a NEWLINE made up there)
       // stops where it starts, beyond the text: its text is empty.
       _start = from.start;
@@ -716,7 +722,7 @@ class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
 
   void Set(const PlaceToken& from, std::size_t type) {
     if (size_ == tokens_.size()) tokens_.push_back(std::make_unique<Reused>(this));
-    tokens_[size_]->Fill(from, type, size_);
+    tokens_[size_]->Fill(from, session_.Column(from), type, size_);
     ++size_;
   }
 
@@ -1280,14 +1286,20 @@ class IrBuilder {
     if (ctx == nullptr || ctx->base == nullptr) return std::nullopt;
     ir::PointExpr point;
     point.loc = s_.Loc(ctx->getStart());
+    // The alternative is the one its first token starts (pointAtom is LL(1),
+    // and a line with an error is never built).
     P::PointAtomContext* atom = ctx->base;
-    if (auto* named = dynamic_cast<P::NamedPointContext*>(atom)) {
+    const std::size_t first = atom->getStart()->getType();
+    if (first == P::ID) {
+      auto* named = static_cast<P::NamedPointContext*>(atom);
       point.base = ir::NamedPoint{Name(named->name), s_.Length(named->getStart())};
-    } else if (auto* literal = dynamic_cast<P::LiteralPointContext*>(atom)) {
+    } else if (first == P::XY) {
+      auto* literal = static_cast<P::LiteralPointContext*>(atom);
       std::optional<ir::Coords> coords = Coords(literal->position);
       if (!coords) return std::nullopt;
       point.base = *coords;
-    } else if (auto* pallet = dynamic_cast<P::PalletPointContext*>(atom)) {
+    } else if (first == P::PALLET) {
+      auto* pallet = static_cast<P::PalletPointContext*>(atom);
       ir::PalletPoint base;
       base.number = Expr(pallet->number);
       base.i = Expr(pallet->i);
@@ -1345,11 +1357,29 @@ class IrBuilder {
   // expr : ... (one labelled alternative per kind of context).
   ir::ExprPtr Expr(P::ExprContext* ctx) {
     if (ctx == nullptr) return nullptr;
-    //      | value=NUMBER
-    if (auto* number = dynamic_cast<P::NumberExprContext*>(ctx)) return MakeExpr(number, Number(number->value));
-    //      | name=ID
-    if (auto* variable = dynamic_cast<P::VariableExprContext*>(ctx)) {
-      return MakeExpr(variable, ir::VariableRef{Name(variable->name)});
+    // An expression of one token can only be a number, a name or On/Off:
+    // no search for its kind of context (most expressions are one number).
+    if (ctx->getStart() == ctx->getStop()) {
+      switch (ctx->getStart()->getType()) {
+        //  | value=NUMBER
+        case P::NUMBER: {
+          auto* number = static_cast<P::NumberExprContext*>(ctx);
+          return MakeExpr(number, Number(number->value));
+        }
+        //  | name=ID
+        case P::ID: {
+          auto* variable = static_cast<P::VariableExprContext*>(ctx);
+          return MakeExpr(variable, ir::VariableRef{Name(variable->name)});
+        }
+        //  | value=(ON | OFF)
+        case P::ON:
+        case P::OFF: {
+          auto* on_off = static_cast<P::OnOffExprContext*>(ctx);
+          return MakeExpr(on_off, ir::OnOffLit{on_off->value != nullptr && on_off->value->getType() == P::ON});
+        }
+        default:
+          return nullptr;
+      }
     }
     //      | lhs=expr op=(...) rhs=expr
     if (auto* binary = dynamic_cast<P::BinaryExprContext*>(ctx)) return Binary(binary);
@@ -1370,10 +1400,6 @@ class IrBuilder {
       ir::ExprPtr bit = Expr(sw->bit);
       if (!bit) return nullptr;
       return MakeExpr(sw, ir::SwitchRead{std::move(bit)});
-    }
-    //      | value=(ON | OFF)
-    if (auto* on_off = dynamic_cast<P::OnOffExprContext*>(ctx)) {
-      return MakeExpr(on_off, ir::OnOffLit{on_off->value != nullptr && on_off->value->getType() == P::ON});
     }
     return nullptr;
   }
@@ -1709,8 +1735,8 @@ void Session::Flush() {
 
 }  // namespace
 
-ir::Program ParseTokens(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags) {
-  return Session(file, std::move(tokens), diags).Run();
+ir::Program ParseTokens(std::uint32_t file, LexedPlace lexed, Diagnostics& diags) {
+  return Session(file, std::move(lexed), diags).Run();
 }
 
 ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags) {

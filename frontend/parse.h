@@ -15,13 +15,13 @@ namespace smtcal {
 // are reported to `diags` (bounded: a file of garbage gives a handful of
 // errors, not one per byte). The returned program holds everything that
 // parsed; when diags has errors it must not be compiled, only inspected.
-// Memory is the IR, the file's tokens (20 bytes each) and one line's parse
+// Memory is the IR, the file's tokens (16 bytes each) and one line's parse
 // tree at a time; running out of it throws std::bad_alloc, never a syntax
 // error.
 ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags);
 
 // The same from tokens already made for the file's text, by LexPlace or by
 // the reference lexer (the differential test parses with both).
-ir::Program ParseTokens(std::uint32_t file, std::vector<PlaceToken> tokens, Diagnostics& diags);
+ir::Program ParseTokens(std::uint32_t file, LexedPlace lexed, Diagnostics& diags);
 
 }  // namespace smtcal

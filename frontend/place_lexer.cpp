@@ -127,17 +127,19 @@ int PunctuationType(std::string_view text, std::size_t at, std::size_t& length) 
 
 }  // namespace
 
-std::vector<PlaceToken> LexPlace(std::string_view text) {
+LexedPlace LexPlace(std::string_view text) {
   SMTCAL_CHECK(text.size() < UINT32_MAX, "the parser refuses files of 4 GiB and more before lexing");
-  std::vector<PlaceToken> tokens;
-  // About one token per 6 bytes in programs; growing beyond is fine.
-  tokens.reserve(text.size() / 6 + 16);
+  LexedPlace lexed;
+  std::vector<PlaceToken>& tokens = lexed.tokens;
+  // Programs have about a token per 3 bytes or fewer. Room reserved but not
+  // used is address space, not memory (its pages are never touched), while
+  // growing a vector of millions of tokens holds it twice for a moment.
+  tokens.reserve(text.size() / 3 + 16);
+  lexed.line_starts = {0, 0};  // line 1 starts at 0 (a byte order mark included: its bytes count as columns)
   std::uint32_t line = 1;
-  std::size_t line_start = 0;
   std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // a byte order mark is white space
   auto add = [&](std::size_t start, std::size_t end, int type) {
-    tokens.push_back(PlaceToken{static_cast<std::uint32_t>(start), static_cast<std::uint32_t>(end - start), line,
-                                static_cast<std::uint32_t>(start - line_start), type});
+    tokens.push_back(PlaceToken{static_cast<std::uint32_t>(start), static_cast<std::uint32_t>(end - start), line, type});
   };
   while (i < text.size()) {
     const auto c = static_cast<unsigned char>(text[i]);
@@ -148,7 +150,7 @@ std::vector<PlaceToken> LexPlace(std::string_view text) {
       i += c == '\r' ? 2 : 1;  // NEWLINE : '\r'? '\n' ;
       add(start, i, L::NEWLINE);
       ++line;
-      line_start = i;
+      lexed.line_starts.push_back(static_cast<std::uint32_t>(i));
     } else if (c == '\'') {  // COMMENT : '\'' ~[\r\n]* -> channel(HIDDEN) ;
       while (i < text.size() && text[i] != '\n' && text[i] != '\r') ++i;
       add(start, i, L::COMMENT);
@@ -174,7 +176,7 @@ std::vector<PlaceToken> LexPlace(std::string_view text) {
     }
   }
   add(text.size(), text.size(), kPlaceEof);
-  return tokens;
+  return lexed;
 }
 
 }  // namespace smtcal

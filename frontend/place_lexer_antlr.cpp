@@ -26,11 +26,13 @@ class ByteStream : public antlr4::ANTLRInputStream {
 
 }  // namespace
 
-std::vector<PlaceToken> LexPlaceWithAntlr(std::string_view text) {
+LexedPlace LexPlaceWithAntlr(std::string_view text) {
   ByteStream stream(text);
   grammar::PlaceLexer lexer(&stream);
   lexer.removeErrorListeners();  // BAD_CHAR takes every byte: nothing to report
-  std::vector<PlaceToken> tokens;
+  LexedPlace lexed;
+  constexpr std::uint32_t kUnset = UINT32_MAX - 1;
+  lexed.line_starts = {0};
   for (;;) {
     std::unique_ptr<antlr4::Token> token = lexer.nextToken();
     const bool eof = token->getType() == antlr4::Token::EOF;
@@ -38,11 +40,20 @@ std::vector<PlaceToken> LexPlaceWithAntlr(std::string_view text) {
     out.start = static_cast<std::uint32_t>(token->getStartIndex());
     out.length = eof ? 0 : static_cast<std::uint32_t>(token->getStopIndex() - token->getStartIndex() + 1);
     out.line = static_cast<std::uint32_t>(token->getLine());
-    out.column = static_cast<std::uint32_t>(token->getCharPositionInLine());
     out.type = eof ? kPlaceEof : static_cast<int>(token->getType());
-    tokens.push_back(out);
-    if (eof) return tokens;
+    lexed.tokens.push_back(out);
+    // Where ANTLR's column puts the line's start; UINT32_MAX when tokens of
+    // one line disagree.
+    if (lexed.line_starts.size() <= out.line) lexed.line_starts.resize(out.line + 1, kUnset);
+    std::uint32_t start = out.start - static_cast<std::uint32_t>(token->getCharPositionInLine());
+    std::uint32_t& line_start = lexed.line_starts[out.line];
+    line_start = line_start == kUnset || line_start == start ? start : UINT32_MAX;
+    if (eof) break;
   }
+  // Lines that hold no token (none: every line ends in a NEWLINE or EOF).
+  for (std::uint32_t& start : lexed.line_starts) start = start == kUnset ? UINT32_MAX : start;
+  lexed.line_starts[0] = 0;
+  return lexed;
 }
 
 std::string PlaceTokenName(int type) {

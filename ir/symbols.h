@@ -53,6 +53,9 @@ struct NameEqual {
 };
 template <typename Value>
 using NameMap = std::unordered_map<std::string, Value, NameHash, NameEqual>;
+// The same keyed by views of names that live elsewhere (a Symbol's name).
+template <typename Value>
+using NameViewMap = std::unordered_map<std::string_view, Value, NameHash, NameEqual>;
 
 // The range of `name` written at `loc` (names are kept as written, so the
 // caret underlines exactly the name).
@@ -82,6 +85,12 @@ class SymbolTable {
 
   // Collects the top-level declarations of `program` (not function locals).
   static SymbolTable Build(const ir::Program& program);
+  // Moved, never copied: the lookups point into the table's own symbols.
+  SymbolTable() = default;
+  SymbolTable(SymbolTable&&) = default;
+  SymbolTable& operator=(SymbolTable&&) = default;
+  SymbolTable(const SymbolTable&) = delete;
+  SymbolTable& operator=(const SymbolTable&) = delete;
 
   const Symbol* Find(std::string_view name) const;
   // First definitions, in source order.
@@ -116,7 +125,7 @@ class SymbolTable {
   const Symbol* PalletFixture(int number) const;
 
   std::deque<Symbol> symbols_;  // deque: Find's pointers stay valid
-  NameMap<const Symbol*> by_name_;  // keyed by the name as declared
+  NameViewMap<const Symbol*> by_name_;  // keyed by the symbol's own name
   std::vector<Duplicate> duplicates_;
   std::map<int, PalletEntry> pallets_;
   std::vector<std::pair<PalletEntry, PalletEntry>> duplicate_pallets_;
@@ -156,7 +165,7 @@ class LocalScope {
  private:
   const SymbolTable& globals_;
   std::deque<Symbol> locals_;
-  NameMap<const Symbol*> by_name_;
+  NameViewMap<const Symbol*> by_name_;  // keyed by the local's own name
 };
 
 // The symbols a VarDecl statement declares (one per name).

@@ -44,6 +44,18 @@ bool UsesPeriphery(SimMode mode) {
   return mode == SimMode::kPeripheryOnly || mode == SimMode::kPaper || mode == SimMode::kImproved;
 }
 
+long PlannedPlacements(const CompileState& state, const SimOptions& options) {
+  long per_round = 0;  // every Cycle statement once
+  for (const CycleEstimate& estimate : state.cycles) {
+    for (const TraceEvent& event : state.cycle_traces.at(estimate.cycle)) {
+      if (event.kind != TraceEvent::Kind::kMotion) continue;
+      const Target& target = state.targets[event.target];
+      if (target.is_placement() && target.known) ++per_round;
+    }
+  }
+  return per_round * options.cycles;
+}
+
 double Percentile(const std::vector<double>& sorted, double q) {
   if (sorted.empty()) return 0;
   const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(sorted.size())));
@@ -184,6 +196,9 @@ class Simulator {
     long planned = 0;
     for (const CyclePlan& plan : plans_) planned += static_cast<long>(plan.placements.size());
     planned *= options_.cycles;
+    // Every placed part's error is kept: room for all of them at once, so the
+    // memory is what PlannedPlacements says, not twice that while a vector grows.
+    for (ModeResult& m : result.modes) m.errors_um.reserve(static_cast<std::size_t>(planned));
     scatter_stride_ = std::max<long>(1, planned / std::max<long>(1, static_cast<long>(options_.scatter_points)));
     previous_.assign(kSimModes.size(), std::vector<std::optional<Eigen::Affine3d>>(state_.fixtures.size()));
     for (int n = 0; n < options_.cycles; ++n) {

@@ -85,6 +85,13 @@ struct SimResult {
 // The compiled program must have passed the correction passes without error.
 SimResult Simulate(const CompileState& state, const TruthSpec& truth, const SimOptions& options);
 
+// The placements a run plans: the known placements of every Cycle's trace,
+// every cycle. Each keeps its error in every mode (ModeResult::errors_um),
+// and the report sorts a copy of one mode's: kSimBytesPerPlacement bytes of
+// memory per planned placement, which a caller can check before running.
+long PlannedPlacements(const CompileState& state, const SimOptions& options);
+inline constexpr std::size_t kSimBytesPerPlacement = sizeof(double) * (kSimModes.size() + 1);
+
 // Nearest-rank percentile (q in [0, 1]) of sorted values; 0 when empty.
 double Percentile(const std::vector<double>& sorted, double q);
 

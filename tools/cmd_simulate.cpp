@@ -2,6 +2,12 @@
 // correction passes of `smtcal compile`), then run on the virtual cell
 // (simulation/virtual_cell.h) in six correction modes on the same random draws;
 // prints the placement accuracy per mode (docs/simulate.md).
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+
 #include <fmt/core.h>
 
 #include "backend/reports/compile_report.h"
@@ -52,6 +58,35 @@ bool CheckTraces(const ir::Program& program, const CompileState& state, Diagnost
   return places;
 }
 
+// The memory this process may use: the machine's, or less under a limit.
+std::uint64_t UsableMemoryBytes() {
+  std::uint64_t bytes = static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES)) * static_cast<std::uint64_t>(sysconf(_SC_PAGESIZE));
+  for (int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit limit{};
+    if (getrlimit(resource, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+      bytes = std::min<std::uint64_t>(bytes, limit.rlim_cur);
+    }
+  }
+  return bytes;
+}
+
+// Every placed part's error is kept (for the percentiles): a run that cannot
+// fit is refused before it starts (exit 3, as other resource failures),
+// never left to run out of memory halfway.
+bool FitsInMemory(const CompileState& state, const SimOptions& sim, GlobalOptions& options) {
+  const long planned = PlannedPlacements(state, sim);
+  const double needed = static_cast<double>(planned) * kSimBytesPerPlacement;
+  const std::uint64_t usable = UsableMemoryBytes();
+  if (needed <= static_cast<double>(usable)) return true;
+  const long per_cycle = planned / sim.cycles;
+  const long cycles = per_cycle > 0 ? static_cast<long>(static_cast<double>(usable) / kSimBytesPerPlacement / per_cycle) : 0;
+  options.exit_code = ReportIoError(Error{fmt::format(
+      "simulating {} cycles of {} placements keeps {:.1f} GB of placement errors ({} bytes a placement), more "
+      "than the {:.1f} GB this process may use; simulate at most {} cycles",
+      sim.cycles, per_cycle, needed / 1e9, kSimBytesPerPlacement, static_cast<double>(usable) / 1e9, cycles)});
+  return false;
+}
+
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
@@ -76,6 +111,7 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;
 
+  if (!FitsInMemory(state, opt.sim, options)) return;
   SimResult result = Simulate(state, truth, opt.sim);
   SimulateContext context{opt.program_path, &*compiled.cell, &truth};
   if (!opt.svg.empty()) {
@@ -101,7 +137,7 @@ void AddSimulateCommand(CLI::App& app, GlobalOptions& options) {
                        "robot accuracy; default: derived from the cell's tables");
   simulate->add_option("--cycles", opt.sim.cycles,
                        "how many times each Cycle statement runs (at most 100000: every placed part's error is kept, "
-                       "48 bytes per planned placement)")
+                       "56 bytes per planned placement; a run that does not fit in memory is refused, exit 3)")
       ->check(CLI::Range(1, 100'000))
       ->capture_default_str();
   simulate->add_option("--seed", opt.sim.seed, "the random seed: the same seed gives the same report")

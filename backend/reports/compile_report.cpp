@@ -42,12 +42,12 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
     json entry{{"statement", TargetKeyword(*target.stmt)},
                {"target", target.text},
                {"location", LocationText(sources, target.stmt->loc)},
-               {"reached_from", target.call_path},
+               {"reached_from", target.call_path.str()},
                {"frame", FixtureName(state, target.fixture)},
                {"correction", CorrectionKindName(target.kind)},
                {"known_at_compile_time", target.known}};
     if (!target.known) {
-      entry["depends_on"] = target.unknown_because;
+      entry["depends_on"] = target.unknown_because.str();
       targets.push_back(std::move(entry));
       continue;
     }

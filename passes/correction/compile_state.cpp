@@ -22,6 +22,20 @@ bool Target::is_placement() const {
   return pick != nullptr && pick->kind == ir::PickPlaceKind::Place;
 }
 
+const std::string& SharedText::Empty() {
+  static const std::string empty;
+  return empty;
+}
+
+SharedText CompileState::Share(std::string_view text) {
+  if (text.empty()) return SharedText();
+  auto it = shared_by_text_.find(text);
+  if (it != shared_by_text_.end()) return SharedText(it->second);
+  const std::string& kept = shared_.emplace_back(text);
+  shared_by_text_.emplace(kept, &kept);
+  return SharedText(&kept);
+}
+
 int CompileState::FindFixture(std::string_view name) const {
   if (name.empty()) return -1;
   for (std::size_t i = 0; i < fixtures.size(); ++i) {

@@ -12,11 +12,16 @@
 
 #include <array>
 #include <cstddef>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include <Eigen/Geometry>
 
@@ -58,15 +63,34 @@ enum class CorrectionKind {
 };
 std::string_view CorrectionKindName(CorrectionKind kind);  // static | run-time | fixture | uncorrected
 
+// Text many targets share (the calls they were reached through, what they
+// depend on): kept once per compile (CompileState::Share), 8 bytes in each
+// Target instead of a string's 32 (a million placements have two million
+// targets).
+class SharedText {
+ public:
+  SharedText() : text_(&Empty()) {}
+  const std::string& str() const { return *text_; }
+  operator const std::string&() const { return *text_; }
+  bool empty() const { return text_->empty(); }
+  friend bool operator==(const SharedText& a, std::string_view b) { return *a.text_ == b; }
+
+ private:
+  friend struct CompileState;
+  explicit SharedText(const std::string* text) : text_(text) {}
+  static const std::string& Empty();
+  const std::string* text_;
+};
+
 struct Target {
   const ir::Stmt* stmt = nullptr;  // the Motion or PickPlace statement
   std::string text;                // the target as written: "Pallet(1, 2, 1)", "R1 + X(dx)"
-  std::string call_path;           // "Main > PlaceLayers" (where it was reached first)
+  SharedText call_path;            // "Main > PlaceLayers" (where it was reached first)
   int fixture = -1;                // index into CompileState::fixtures; -1 = robot base
   const ir::Stmt* taught_decl = nullptr;  // a taught point's declaration
   Pose4 taught_offset{};           // taught targets: the offsets written after the point
   bool known = true;               // false: depends on values known only at run time
-  std::string unknown_because;     // what it depends on, for messages
+  SharedText unknown_because;      // what it depends on, for messages
   // The position in its frame: the fixture's (fixture targets) or the base's.
   Pose4 in_frame{};
   // Required position in the robot base frame (fixture targets: at the
@@ -122,6 +146,8 @@ struct CompileState {
   bool trace_complete = true;  // false: the run hit its step limit (reported)
 
   int FindFixture(std::string_view name) const;  // index or -1, case-insensitive
+  // The one copy of `text` this compile keeps.
+  SharedText Share(std::string_view text);
   // One solver per region, made on first use (tables are validated at load).
   const InverseSolver& SolverFor(const cell::Region& region);
   // The sensor's share of the position error at a fixture point (mm),
@@ -130,6 +156,8 @@ struct CompileState {
 
  private:
   std::map<const cell::Region*, std::unique_ptr<InverseSolver>> solvers_;
+  std::deque<std::string> shared_;  // deque: SharedText's pointers stay valid
+  std::unordered_map<std::string_view, const std::string*> shared_by_text_;
   std::map<const cell::Fixture*, std::unique_ptr<SensorShare>> sensor_shares_;
 };
 
@@ -147,3 +175,12 @@ inline double Radians(double degrees) { return degrees * kRadPerDeg; }
 inline Eigen::Vector2d Xy(const Pose4& pose) { return {pose[0], pose[1]}; }
 
 }  // namespace smtcal
+
+// Shared texts format as their text (diagnostics take them as arguments).
+template <>
+struct fmt::formatter<smtcal::SharedText> : fmt::formatter<std::string_view> {
+  template <typename FormatContext>
+  auto format(const smtcal::SharedText& text, FormatContext& ctx) const {
+    return fmt::formatter<std::string_view>::format(text.str(), ctx);
+  }
+};

@@ -11,8 +11,9 @@
 // base-frame statement with one known position is static, one with several
 // positions or an unknown one is corrected at run time, and a Jump/Go/Move
 // outside every region is commanded uncorrected (warned). Never changes the IR.
-#include <map>
 #include <memory>
+#include <unordered_map>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -46,11 +47,12 @@ class Regions final : public Pass {
     for (const cell::Region& region : cell.regions) CheckDifficulty(region, diags);
 
     // A base-frame statement is static only when it has one known position.
-    std::map<const ir::Stmt*, int> positions;
-    std::map<const ir::Stmt*, bool> any_unknown;
+    std::unordered_map<const ir::Stmt*, int> positions;
+    std::unordered_set<const ir::Stmt*> any_unknown;
+    positions.reserve(state.targets.size());
     for (const Target& target : state.targets) {
       ++positions[target.stmt];
-      if (!target.known) any_unknown[target.stmt] = true;
+      if (!target.known) any_unknown.insert(target.stmt);
     }
     for (Target& target : state.targets) {
       std::string_view keyword = TargetKeyword(*target.stmt);
@@ -58,7 +60,7 @@ class Regions final : public Pass {
       if (target.fixture >= 0) {
         target.kind = CorrectionKind::kFixture;
       } else {
-        bool single = positions[target.stmt] == 1 && !any_unknown[target.stmt];
+        bool single = positions[target.stmt] == 1 && !any_unknown.contains(target.stmt);
         target.kind = single ? CorrectionKind::kStatic : CorrectionKind::kRunTimeBase;
       }
       if (!target.known) {

@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <tuple>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -213,11 +214,11 @@ class Tracer {
     Target target;
     target.stmt = &stmt;
     target.text = PrintPointExpr(point);
-    target.call_path = frame.call_path;
+    target.call_path = state_.Share(frame.call_path);
     target.taught_decl = taught_decl;
     if (auto* unknown = std::get_if<Unknown>(&position)) {
       target.known = false;
-      target.unknown_because = unknown->because;
+      target.unknown_because = state_.Share(unknown->because);
       // The frame is still known: the point's declaration decides it.
       target.fixture = state_.FindFixture(FrameRootOf(point, frame));
     } else {
@@ -232,10 +233,30 @@ class Tracer {
     // A fixture the cell does not describe is reported by bind; its targets
     // have no frame to be corrected in.
     if (target.fixture < 0 && FixtureNamed(point, frame)) return;
-    auto key = std::make_tuple(&stmt, target.known, target.in_frame);
-    auto [it, inserted] = seen_.emplace(key, state_.targets.size());
-    if (inserted) state_.targets.push_back(std::move(target));
-    if (trace_ != nullptr && !exploring_) trace_->push_back({TraceEvent::Kind::kMotion, it->second, 0});
+    std::size_t index = FindOrAddTarget(std::move(target));
+    if (trace_ != nullptr && !exploring_) trace_->push_back({TraceEvent::Kind::kMotion, index, 0});
+  }
+
+  // Targets are unique per (statement, known, position). The targets of one
+  // statement are chained (most statements have one), so the lookup costs a
+  // hash of the statement and no node per target.
+  std::size_t FindOrAddTarget(Target target) {
+    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+    next_of_stmt_.resize(state_.targets.size(), kNone);
+    auto [first, inserted] = first_of_stmt_.emplace(target.stmt, state_.targets.size());
+    if (!inserted) {
+      std::size_t i = first->second;
+      for (;;) {
+        const Target& seen = state_.targets[i];
+        if (seen.known == target.known && seen.in_frame == target.in_frame) return i;
+        if (next_of_stmt_[i] == kNone) break;
+        i = next_of_stmt_[i];
+      }
+      next_of_stmt_[i] = state_.targets.size();
+    }
+    state_.targets.push_back(std::move(target));
+    next_of_stmt_.push_back(kNone);
+    return state_.targets.size() - 1;
   }
 
   // Whether the target hangs on a fixture (bound to the cell or not).
@@ -411,7 +432,8 @@ class Tracer {
   const sema::SymbolTable& symbols_;
   CompileState& state_;
   Variables globals_;
-  std::map<std::tuple<const ir::Stmt*, bool, Pose4>, std::size_t> seen_;
+  std::unordered_map<const ir::Stmt*, std::size_t> first_of_stmt_;  // index into state_.targets
+  std::vector<std::size_t> next_of_stmt_;  // per target: the next target of its statement
   std::vector<TraceEvent>* trace_ = nullptr;
   bool exploring_ = false;  // in a branch the cycle trace does not follow
   long steps_ = 0;
@@ -446,7 +468,14 @@ RootedPose ResolveFrame(const sema::SymbolTable& symbols, const std::string& fra
   return rooted;
 }
 
-void TraceTargets(const ir::Program& /*program*/, const sema::SymbolTable& symbols, CompileState& state) {
+void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, CompileState& state) {
+  // Room for one target per motion statement: most have one, and growing a
+  // vector of a million targets would hold it twice for a moment.
+  std::size_t motions = 0;
+  ir::ForEachStmt(program.items, [&](const ir::Stmt& stmt) {
+    motions += std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node);
+  });
+  state.targets.reserve(state.targets.size() + motions);
   Tracer(symbols, state).Run();
 }
 

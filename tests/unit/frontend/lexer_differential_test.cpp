@@ -2,7 +2,7 @@
 // lexer ANTLR generates from grammar/Place.g4: on every .place file of the
 // golden suites and the examples, and on random programs (seeded; the seed is
 // printed, SMTCAL_TEST_SEED varies it), both give the same tokens (type,
-// offset, length, line, column), and parsing either token list gives the
+// offset, length, line, column) and lines, and parsing either gives the
 // same diagnostics and the same IR.
 #include <algorithm>
 #include <cstdlib>
@@ -29,22 +29,25 @@ std::uint64_t Seed() {
   return text != nullptr ? std::strtoull(text, nullptr, 10) : 19940516;
 }
 
-std::string Describe(const PlaceToken& token) {
+std::string Describe(const LexedPlace& lexed, std::size_t i) {
+  const PlaceToken& token = lexed.tokens[i];
   return fmt::format("{} at {}+{} (line {}, column {})", PlaceTokenName(token.type), token.start, token.length,
-                     token.line, token.column);
+                     token.line, lexed.Column(token));
 }
 
-// The first token where the two lexers differ, described; "" when they agree.
-std::string FirstDifference(const std::vector<PlaceToken>& ours, const std::vector<PlaceToken>& reference) {
-  std::size_t n = std::min(ours.size(), reference.size());
+// The first token where the two lexers differ (column included), described;
+// "" when they agree.
+std::string FirstDifference(const LexedPlace& ours, const LexedPlace& reference) {
+  std::size_t n = std::min(ours.tokens.size(), reference.tokens.size());
   for (std::size_t i = 0; i < n; ++i) {
-    if (!(ours[i] == reference[i])) {
-      return fmt::format("token {}: ours {}, ANTLR's {}", i, Describe(ours[i]), Describe(reference[i]));
+    if (!(ours.tokens[i] == reference.tokens[i]) || ours.Column(ours.tokens[i]) != reference.Column(reference.tokens[i])) {
+      return fmt::format("token {}: ours {}, ANTLR's {}", i, Describe(ours, i), Describe(reference, i));
     }
   }
-  if (ours.size() != reference.size()) {
-    return fmt::format("ours has {} tokens, ANTLR's {}", ours.size(), reference.size());
+  if (ours.tokens.size() != reference.tokens.size()) {
+    return fmt::format("ours has {} tokens, ANTLR's {}", ours.tokens.size(), reference.tokens.size());
   }
+  if (ours.line_starts != reference.line_starts) return "the lines start at other offsets";
   return "";
 }
 
@@ -53,18 +56,18 @@ struct ParseResult {
   std::string ir;
 };
 
-ParseResult Parse(const std::string& text, std::vector<PlaceToken> tokens) {
+ParseResult Parse(const std::string& text, LexedPlace lexed) {
   SourceManager sources;
   std::uint32_t file = sources.Add("t.place", text);
   Diagnostics diags(sources);
-  ir::Program program = ParseTokens(file, std::move(tokens), diags);
+  ir::Program program = ParseTokens(file, std::move(lexed), diags);
   return {diags.RenderText(), DumpIr(program, true)};
 }
 
 // Both lexers, and the parser on both token lists.
 void ExpectSameAsReference(const std::string& text) {
-  std::vector<PlaceToken> ours = LexPlace(text);
-  std::vector<PlaceToken> reference = LexPlaceWithAntlr(text);
+  LexedPlace ours = LexPlace(text);
+  LexedPlace reference = LexPlaceWithAntlr(text);
   ASSERT_EQ(FirstDifference(ours, reference), "");
   ParseResult with_ours = Parse(text, std::move(ours));
   ParseResult with_reference = Parse(text, std::move(reference));
