@@ -1654,51 +1654,34 @@ ir::Program Session::Run() {
       const Line& line = lines_[n];
       close_added(ClosersBefore(line));
       if (line.empty()) continue;
+      // A block's first line: its rule, and the IR of its statement.
+      auto open = [&](std::size_t type, auto rule, auto head) {
+        auto* ctx = parser.Parse(line, rule);
+        blocks.Open(type, n, [&] { return (ir.*head)(ctx); });
+      };
+      // A block's last line (Fend, EndIf, EndCycle; Next has its variable).
+      auto close = [&](std::size_t type, auto rule) {
+        blocks.Close(type, n, ir.End(parser.Parse(line, rule)->getStart()));
+      };
       switch (TypeOf(At(line.first))) {
-        case P::FUNCTION: {
-          P::FunctionHeadContext* head = parser.Parse(line, &PlaceParser::functionHead);
-          blocks.Open(P::FUNCTION, n, [&] { return ir.FunctionHead(head); });
-          break;
-        }
-        case P::FOR: {
-          P::ForHeadContext* head = parser.Parse(line, &PlaceParser::forHead);
-          blocks.Open(P::FOR, n, [&] { return ir.ForHead(head); });
-          break;
-        }
-        case P::IF: {
-          P::IfHeadContext* head = parser.Parse(line, &PlaceParser::ifHead);
-          blocks.Open(P::IF, n, [&] { return ir.IfHead(head); });
-          break;
-        }
-        case P::CYCLE: {
-          P::CycleHeadContext* head = parser.Parse(line, &PlaceParser::cycleHead);
-          blocks.Open(P::CYCLE, n, [&] { return ir.CycleHead(head); });
-          break;
-        }
+        case P::FUNCTION: open(P::FUNCTION, &PlaceParser::functionHead, &IrBuilder::FunctionHead); break;
+        case P::FOR: open(P::FOR, &PlaceParser::forHead, &IrBuilder::ForHead); break;
+        case P::IF: open(P::IF, &PlaceParser::ifHead, &IrBuilder::IfHead); break;
+        case P::CYCLE: open(P::CYCLE, &PlaceParser::cycleHead, &IrBuilder::CycleHead); break;
         case P::ELSEIF: {
           P::ElseIfHeadContext* head = parser.Parse(line, &PlaceParser::elseIfHead);
           blocks.ElseIf(n, [&] { return ir.ElseIfHead(head); });
           break;
         }
-        case P::ELSE: {
-          P::ElseHeadContext* head = parser.Parse(line, &PlaceParser::elseHead);
-          blocks.Else(n, ir.ElseHead(head));
-          break;
-        }
-        case P::FEND:
-          blocks.Close(P::FUNCTION, n, ir.End(parser.Parse(line, &PlaceParser::fendLine)->getStart()));
-          break;
+        case P::ELSE: blocks.Else(n, ir.ElseHead(parser.Parse(line, &PlaceParser::elseHead))); break;
+        case P::FEND: close(P::FUNCTION, &PlaceParser::fendLine); break;
         case P::NEXT: {
           P::NextLineContext* next = parser.Parse(line, &PlaceParser::nextLine);
           blocks.Close(P::FOR, n, ir.End(next->getStart()), ir.Name(next->var), ir.Loc(next->var));
           break;
         }
-        case P::ENDIF:
-          blocks.Close(P::IF, n, ir.End(parser.Parse(line, &PlaceParser::endIfLine)->getStart()));
-          break;
-        case P::ENDCYCLE:
-          blocks.Close(P::CYCLE, n, ir.End(parser.Parse(line, &PlaceParser::endCycleLine)->getStart()));
-          break;
+        case P::ENDIF: close(P::IF, &PlaceParser::endIfLine); break;
+        case P::ENDCYCLE: close(P::CYCLE, &PlaceParser::endCycleLine); break;
         default:
           if (blocks.AtTopLevel()) {
             P::DeclarationLineContext* decl = parser.Parse(line, &PlaceParser::declarationLine);

@@ -21,8 +21,15 @@ using L = grammar::PlaceLexer;
 
 static_assert(kPlaceEof == static_cast<int>(antlr4::Token::EOF));
 
-bool IsLetter(unsigned char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
-bool IsDigit(unsigned char c) { return c >= '0' && c <= '9'; }
+constexpr bool IsLetter(unsigned char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
+constexpr bool IsDigit(unsigned char c) { return c >= '0' && c <= '9'; }
+// The bytes an identifier continues with, [a-zA-Z_0-9], as a table: a
+// program's bytes are mostly names.
+constexpr std::array<bool, 256> kWordByte = [] {
+  std::array<bool, 256> table{};
+  for (int c = 0; c < 256; ++c) table[c] = IsLetter(static_cast<unsigned char>(c)) || IsDigit(static_cast<unsigned char>(c));
+  return table;
+}();
 
 // The keywords, as the grammar spells their letters (case-insensitive).
 struct Keyword {
@@ -155,10 +162,7 @@ LexedPlace LexPlace(std::string_view text) {
       while (i < text.size() && text[i] != '\n' && text[i] != '\r') ++i;
       add(start, i, L::COMMENT);
     } else if (IsLetter(c)) {
-      while (i < text.size() && (IsLetter(static_cast<unsigned char>(text[i])) ||
-                                 IsDigit(static_cast<unsigned char>(text[i])))) {
-        ++i;
-      }
+      while (i < text.size() && kWordByte[static_cast<unsigned char>(text[i])]) ++i;
       add(start, i, WordType(text.substr(start, i - start)));
     } else if (IsDigit(c) || c == '.') {
       i = NumberEnd(text, start);

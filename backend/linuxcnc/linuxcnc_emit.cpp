@@ -95,6 +95,14 @@ std::string Quoted(std::string_view text) {
   if (text.size() <= kMaxQuotedChars) return std::string(text);
   return std::string(text.substr(0, kMaxQuotedChars - 3)) + "...";
 }
+void AppendQuoted(std::string& out, std::string_view text) {
+  if (text.size() <= kMaxQuotedChars) {
+    out += text;
+  } else {
+    out += text.substr(0, kMaxQuotedChars - 3);
+    out += "...";
+  }
+}
 
 std::string Lower(std::string_view name) { return sema::Lowercase(name); }
 
@@ -371,39 +379,56 @@ class Emitter {
   // the four parameters on one line with the declaration in its comment; a
   // line too long for rs274 (long names) is split into one line per axis.
   void EmitPoints() {
+    static constexpr std::array<char, 4> kAxes = {'x', 'y', 'z', 'u'};
     for (const ir::StmtPtr& item : program_.items) {
       const auto* decl = std::get_if<ir::PointDecl>(&item->node);
       if (decl == nullptr) continue;
       const RootedPose rooted = RootOf(*decl);
-      const std::array<std::string, 4> params = PointParams(decl->name);
+      const std::string name = Lower(decl->name);
       std::string& out = out_.buffer();
       const std::size_t begin = out.size();
       for (int a = 0; a < 4; ++a) {
-        if (a > 0) out += ' ';
-        out += params[a];
-        out += " = ";
+        out += a > 0 ? " #<_p_" : "#<_p_";
+        out += name;
+        out += '_';
+        out += kAxes[a];
+        out += "> = ";
         AppendLinuxCncNumber(out, RoundForProgramText(rooted.pose[a]));
       }
-      // Names are identifiers: nothing in them needs sanitizing.
-      std::string what = decl->taught ? "Taught Point " : "Point ";
-      what += Quoted(decl->name);
-      if (!decl->frame.empty()) {
-        what += decl->taught ? " On " : " In ";
-        what += Quoted(decl->frame);
-      }
-      what += rooted.fixture.empty() ? " -> robot base frame" : " -> fixture " + Quoted(rooted.fixture) + " frame";
       out += " (";
       AppendWhere(out, item->loc);
       out += ' ';
-      out += what;
+      AppendPointComment(out, *decl, rooted);
       out += ")\n";
       if (out.size() - begin - 1 <= kMaxLineChars) {
         out_.Produced();
         continue;
       }
       out.resize(begin);  // too long for rs274 (long names): one line per axis
+      std::string what;
+      AppendPointComment(what, *decl, rooted);
       Comment(what, item->loc);
-      for (int a = 0; a < 4; ++a) Line(fmt::format("{} = {}", params[a], Num(RoundForProgramText(rooted.pose[a]))), item->loc);
+      for (int a = 0; a < 4; ++a) {
+        Line(fmt::format("#<_p_{}_{}> = {}", name, kAxes[a], Num(RoundForProgramText(rooted.pose[a]))), item->loc);
+      }
+    }
+  }
+
+  // "Point P In Layer1 -> fixture Board frame": the declaration and where its
+  // parameters are. Names are identifiers: nothing in them needs sanitizing.
+  static void AppendPointComment(std::string& out, const ir::PointDecl& decl, const RootedPose& rooted) {
+    out += decl.taught ? "Taught Point " : "Point ";
+    AppendQuoted(out, decl.name);
+    if (!decl.frame.empty()) {
+      out += decl.taught ? " On " : " In ";
+      AppendQuoted(out, decl.frame);
+    }
+    if (rooted.fixture.empty()) {
+      out += " -> robot base frame";
+    } else {
+      out += " -> fixture ";
+      AppendQuoted(out, rooted.fixture);
+      out += " frame";
     }
   }
 
@@ -808,11 +833,15 @@ class Emitter {
     ReadSwitches(stmt);
     int fixture = -1;
     Command command = CommandOf(stmt, pick.target, &fixture);
-    Position target = PositionOf(pick.target, stmt.loc);
     if (command != Command::kFixture) fixture = command == Command::kRunTimeBase ? kPickPlaceBase : kPickPlaceAsWritten;
+    // A point or an XY(...) without offsets is written straight into the
+    // call; anything else is computed into temporaries first.
+    const bool direct = pick.target.offsets.empty() && !std::holds_alternative<ir::PalletPoint>(pick.target.base);
+    Position target;
+    if (!direct) target = PositionOf(pick.target, stmt.loc);
     if (safe_limz_.empty()) safe_limz_ = Num(cell_.robot.safe_limz_mm);
     GExpr limz = pick.limz ? Expr(*pick.limz) : safe_limz_;
-    GExpr vacuum = pick.vacuum ? Expr(*pick.vacuum) : Num(DefaultVacuum());
+    GExpr vacuum = pick.vacuum ? Expr(*pick.vacuum) : DefaultVacuum();
     std::string& out = Begin();
     const std::size_t begin = out.size();
     auto argument = [&](std::string_view text) {
@@ -823,7 +852,24 @@ class Emitter {
     char digits[16];
     out += "o<pick_place> call";
     argument(std::string_view(digits, std::to_chars(digits, digits + sizeof digits, fixture).ptr));
-    for (const GExpr& axis : target.xyzu) argument(axis);
+    if (!direct) {
+      for (const GExpr& axis : target.xyzu) argument(axis);
+    } else if (const auto* coords = std::get_if<ir::Coords>(&pick.target.base)) {
+      for (double value : coords->values) {
+        out += " [";
+        AppendLinuxCncNumber(out, value);
+        out += ']';
+      }
+    } else {
+      const std::string name = Lower(std::get<ir::NamedPoint>(pick.target.base).name);
+      for (char axis : {'x', 'y', 'z', 'u'}) {
+        out += " [#<_p_";
+        out += name;
+        out += '_';
+        out += axis;
+        out += ">]";
+      }
+    }
     argument(limz);
     argument(vacuum);
     argument(pick.kind == ir::PickPlaceKind::Pick ? "1" : "0");
@@ -893,9 +939,11 @@ class Emitter {
     block("o<pick_place> endsub");
   }
 
-  double DefaultVacuum() const {
+  // The program's `Vacuum n`, as written (made once).
+  const std::string& DefaultVacuum() {
     SMTCAL_CHECK(default_vacuum_.has_value(), "a checked Pick/Place without Vacuum has the program's Vacuum");
-    return *default_vacuum_;
+    if (default_vacuum_text_.empty()) default_vacuum_text_ = Num(*default_vacuum_);
+    return default_vacuum_text_;
   }
 
   const ir::Program& program_;
@@ -908,6 +956,7 @@ class Emitter {
   std::unordered_map<const ir::Stmt*, bool> as_written_;
   std::unordered_map<const sema::Symbol*, int> cell_fixture_of_;  // FixtureIndexOf's answers
   std::string safe_limz_;  // the robot's safe_limz_mm, as written
+  std::string default_vacuum_text_;  // the program's `Vacuum n`, as written
   std::optional<int> default_vacuum_;                   // the program's `Vacuum n`
   std::map<const ir::Expr*, std::string> switches_;
   std::set<std::string> locals_;  // the current function's, lowercase

@@ -76,10 +76,10 @@ class StaticInversion final : public Pass {
     coords.loc = point->loc;
     point->base = coords;
     point->offsets.clear();
-    std::string note = fmt::format("required {} = {}, region {}, residual {} mm", target.text,
-                                   PrintCoords({target.required, {}}), target.region->name,
-                                   fmt::format("{:.1e}", target.residual_mm));
-    stmt.trailing_comment = stmt.trailing_comment.empty() ? " " + note : stmt.trailing_comment + "; " + note;
+    std::string& comment = stmt.trailing_comment;
+    comment += comment.empty() ? " " : "; ";
+    comment += fmt::format("required {} = {}, region {}, residual {:.1e} mm", target.text,
+                           PrintCoords({target.required, {}}), target.region->name, target.residual_mm);
   }
 };
 
