@@ -1280,26 +1280,20 @@ class IrBuilder {
   }
 
   // ---- points
-  // pointExpr : base=pointAtom (signs+=('+' | '-') offsets+=offset)* ;
-  // offset    : axis=ID '(' amount=expr ')' ;
+  // pointExpr   : (name=ID | position=coords | pallet=palletPoint) (signs+=('+' | '-') offsets+=offset)* ;
+  // palletPoint : PALLET '(' number=expr ',' i=expr (',' j=expr)? ')' ;
+  // offset      : axis=ID '(' amount=expr ')' ;
   std::optional<ir::PointExpr> Point(P::PointExprContext* ctx) {
-    if (ctx == nullptr || ctx->base == nullptr) return std::nullopt;
+    if (ctx == nullptr) return std::nullopt;
     ir::PointExpr point;
     point.loc = s_.Loc(ctx->getStart());
-    // The alternative is the one its first token starts (pointAtom is LL(1),
-    // and a line with an error is never built).
-    P::PointAtomContext* atom = ctx->base;
-    const std::size_t first = atom->getStart()->getType();
-    if (first == P::ID) {
-      auto* named = static_cast<P::NamedPointContext*>(atom);
-      point.base = ir::NamedPoint{Name(named->name), s_.Length(named->getStart())};
-    } else if (first == P::XY) {
-      auto* literal = static_cast<P::LiteralPointContext*>(atom);
-      std::optional<ir::Coords> coords = Coords(literal->position);
+    if (ctx->name != nullptr) {
+      point.base = ir::NamedPoint{Name(ctx->name), s_.Length(ctx->name)};
+    } else if (ctx->position != nullptr) {
+      std::optional<ir::Coords> coords = Coords(ctx->position);
       if (!coords) return std::nullopt;
       point.base = *coords;
-    } else if (first == P::PALLET) {
-      auto* pallet = static_cast<P::PalletPointContext*>(atom);
+    } else if (P::PalletPointContext* pallet = ctx->pallet) {
       ir::PalletPoint base;
       base.number = Expr(pallet->number);
       base.i = Expr(pallet->i);
@@ -1360,25 +1354,13 @@ class IrBuilder {
     // An expression of one token can only be a number, a name or On/Off:
     // no search for its kind of context (most expressions are one number).
     if (ctx->getStart() == ctx->getStop()) {
-      switch (ctx->getStart()->getType()) {
-        //  | value=NUMBER
-        case P::NUMBER: {
-          auto* number = static_cast<P::NumberExprContext*>(ctx);
-          return MakeExpr(number, Number(number->value));
-        }
-        //  | name=ID
-        case P::ID: {
-          auto* variable = static_cast<P::VariableExprContext*>(ctx);
-          return MakeExpr(variable, ir::VariableRef{Name(variable->name)});
-        }
-        //  | value=(ON | OFF)
-        case P::ON:
-        case P::OFF: {
-          auto* on_off = static_cast<P::OnOffExprContext*>(ctx);
-          return MakeExpr(on_off, ir::OnOffLit{on_off->value != nullptr && on_off->value->getType() == P::ON});
-        }
-        default:
-          return nullptr;
+      Token* token = ctx->getStart();
+      switch (token->getType()) {
+        case P::NUMBER: return MakeExpr(ctx, Number(token));               //  | NUMBER
+        case P::ID: return MakeExpr(ctx, ir::VariableRef{Name(token)});   //  | ID
+        case P::ON: return MakeExpr(ctx, ir::OnOffLit{true});              //  | (ON | OFF)
+        case P::OFF: return MakeExpr(ctx, ir::OnOffLit{false});
+        default: return nullptr;
       }
     }
     //      | lhs=expr op=(...) rhs=expr

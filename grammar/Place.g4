@@ -81,11 +81,10 @@ exitStmt    : EXIT FUNCTION ;
 // ---------------------------------------------------------------- points
 // P + X(d): the offset axis is an identifier (X, Y, Z or U) so that x, y, z
 // and u stay usable as variable names; the parser checks it.
-pointExpr   : base=pointAtom (signs+=('+' | '-') offsets+=offset)* ;
-pointAtom   : name=ID                                                     # namedPoint
-            | position=coords                                             # literalPoint
-            | PALLET '(' number=expr ',' i=expr (',' j=expr)? ')'         # palletPoint
-            ;
+// The point itself is an alternative of pointExpr, not a rule of its own
+// (a rule level costs the parser about as much as a token).
+pointExpr   : (name=ID | position=coords | pallet=palletPoint) (signs+=('+' | '-') offsets+=offset)* ;
+palletPoint : PALLET '(' number=expr ',' i=expr (',' j=expr)? ')' ;
 offset      : axis=ID '(' amount=expr ')' ;
 
 // ---------------------------------------------------------------- expressions
@@ -97,10 +96,12 @@ expr        : '(' inner=expr ')'                                          # pare
             | lhs=expr op=AND rhs=expr                                    # binaryExpr
             | lhs=expr op=(OR | XOR) rhs=expr                             # binaryExpr
             | SW '(' bit=expr ')'                                         # switchExpr
-            | value=(ON | OFF)                                            # onOffExpr
-            | value=NUMBER                                                # numberExpr
-            | name=ID                                                     # variableExpr
+            | (ON | OFF)                                                  # onOffExpr
+            | NUMBER                                                      # numberExpr
+            | ID                                                          # variableExpr
             ;
+// (The one-token alternatives have no label: the token is the context's
+// start, and a label in a left-recursive rule costs the parser a type check.)
 
 // ---------------------------------------------------------------- tokens
 PROGRAM  : P R O G R A M ;

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake
   antlr4 libantlr4-runtime-dev default-jre-headless
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev
-  libgtest-dev libbenchmark-dev
+  libgtest-dev libbenchmark-dev libmimalloc-dev
   linuxcnc-uspace
   locales
 )
