@@ -3,6 +3,7 @@
 // program, verify only reports.
 #include <fmt/core.h>
 
+#include "base/json_text.h"
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_emit.h"
 #include "backend/place/place_printer.h"
@@ -52,17 +53,6 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
                        std::make_move_iterator(header.end()));
 }
 
-std::vector<CRuntimePoint> FixturePoints(const CompileState& state) {
-  std::vector<CRuntimePoint> points;
-  for (const Target& target : state.targets) {
-    if (target.kind != CorrectionKind::kFixture || !target.known) continue;
-    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].cell_fixture->name,
-                                   Eigen::Vector2d(target.in_frame[0], target.in_frame[1]), target.in_frame[2],
-                                   target.in_frame[3], target.stmt->loc});
-  }
-  return points;
-}
-
 std::string ProgramName(const ir::Program& program) {
   for (const ir::StmtPtr& item : program.items) {
     if (const auto* decl = std::get_if<ir::ProgramDecl>(&item->node)) return decl->name;
@@ -92,21 +82,27 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       options.exit_code = kExitInputError;
       return;
     }
-    text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
+    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ProgramName(compiled.program));
   } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
     text = PrintPlace(compiled.program);
   }
+  // The report and the program are written together or not at all: the
+  // report waits, complete, beside its file until the program is written.
+  std::optional<StagedOutput> report;
   if (!opt.report.empty()) {
-    std::string report = CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n";
-    if (Status written = WriteFileAtomically(opt.report, report); !written) {
-      options.exit_code = ReportIoError(written.error());
+    Result<StagedOutput> staged =
+        StagedOutput::Stage(opt.report, JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags))));
+    if (!staged) {
+      options.exit_code = ReportIoError(staged.error());
       return;
     }
+    report.emplace(std::move(staged).value());
   }
   Status written = !linuxcnc             ? WriteFileAtomically(opt.output, text)
                    : opt.output == "-"    ? WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc))
                                           : WriteLinuxCncDirectory(opt.output, *linuxcnc);
+  if (written && report) written = report->Commit();
   if (!written) options.exit_code = ReportIoError(written.error());
 }
 
@@ -117,9 +113,9 @@ void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
   if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
   options.exit_code = PrintDiagnostics(diags, options);
   const CompileState& state = *compiled.program.compile;
-  std::string text = opt.json ? CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n"
+  std::string text = opt.json ? JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags)))
                               : VerifySummaryText(compiled.program, state, sources, Counts(diags));
-  fmt::print("{}", text);
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
 }
 
 void AddCommonOptions(CLI::App& command, CompileOptions& opt) {

@@ -4,6 +4,7 @@
 // prints the placement accuracy per mode (docs/simulate.md).
 #include <fmt/core.h>
 
+#include "base/json_text.h"
 #include "backend/reports/compile_report.h"
 #include "backend/reports/simulate_report.h"
 #include "calibration/cell.h"
@@ -84,7 +85,8 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
       return;
     }
   }
-  fmt::print("{}", opt.json ? SimulateReportJson(result, context).dump(2) + "\n" : SimulateReportText(result, context));
+  std::string text = opt.json ? JsonText(SimulateReportJson(result, context)) : SimulateReportText(result, context);
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
 }
 
 }  // namespace

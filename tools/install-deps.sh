@@ -8,6 +8,7 @@ packages=(
   antlr4 libantlr4-runtime-dev default-jre-headless
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev
   libgtest-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev  # the fuzz harnesses: clang and its libFuzzer runtime (tests/fuzz/)
   linuxcnc-uspace
   locales
 )

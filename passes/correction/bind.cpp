@@ -42,7 +42,7 @@ class Bind final : public Pass {
       }
       if (const auto* pallet = std::get_if<ir::PalletDecl>(&item->node)) CheckPalletCorners(*item, *pallet, symbols, diags);
     }
-    TraceTargets(program, symbols, state);
+    TraceTargets(program, symbols, state, diags);
     if (!state.trace_complete) {
       const sema::Symbol* main = symbols.Find("Main");
       diags.Report(DiagKind::TraceIncomplete, main != nullptr ? main->range : SourceRange{}, kMaxTraceSteps);
