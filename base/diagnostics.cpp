@@ -34,10 +34,11 @@ std::string Location(const SourceManager& sources, const SourceRange& range) {
 
 // A source line longer than this many bytes is quoted as a window around
 // the caret, with "..." where it is cut: a 2 MB CSV header line must not
-// make a message of 2 MB.
-constexpr std::size_t kSnippetMaxBytes = 200;
-constexpr std::size_t kSnippetBytesBeforeCaret = 80;
+// make a message of 2 MB. Program lines of a few hundred bytes stay whole.
+constexpr std::size_t kSnippetMaxBytes = 320;
+constexpr std::size_t kSnippetBytesBeforeCaret = 120;
 constexpr std::string_view kEllipsis = "...";
+constexpr std::size_t kMaxMessageBytes = 1000;
 
 bool IsContinuationByte(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
@@ -119,6 +120,14 @@ std::string_view SeverityName(Severity severity) {
 
 Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
   if (limit_reached_) return nullptr;
+  // A message quotes fields of the input; a 2 MB column name must not make
+  // a 2 MB message. Cut at a character boundary.
+  if (message.size() > kMaxMessageBytes) {
+    std::size_t cut = kMaxMessageBytes;
+    while (cut > 0 && IsContinuationByte(message[cut])) --cut;
+    message.resize(cut);
+    message += kEllipsis;
+  }
   Severity severity = DiagKindSeverity(kind);
   if (severity == Severity::Error && error_count_ >= error_limit_) {
     limit_reached_ = true;
