@@ -28,6 +28,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <new>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -726,6 +727,8 @@ class SyntaxErrorListener : public antlr4::BaseErrorListener {
       } else {
         expected = parser->getExpectedTokens();
       }
+    } catch (const std::bad_alloc&) {
+      throw;
     } catch (const std::exception&) {
       deep = true;  // no expected set; fall back to a plain message
     }
@@ -1488,6 +1491,8 @@ ir::Program Session::Run() {
       if (tokens.index() == before) parser.consume();  // never loop in place
     }
     program.items = top.Finish(last_line() + 1);
+  } catch (const std::bad_alloc&) {
+    throw;  // out of memory is no syntax error: the driver reports it (exit 3)
   } catch (const std::exception& e) {
     // ANTLR gave up in a way its recovery does not cover; say so plainly.
     Error(DiagKind::SyntaxError, SourceLoc{file_, 0, 0},

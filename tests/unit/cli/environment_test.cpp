@@ -209,6 +209,27 @@ TEST_F(Environment, ReportAndProgramAreWrittenTogetherOrNotAtAll) {
   EXPECT_FALSE(test::ReadFileText(Path("out.place")).empty());
 }
 
+// Out of memory is reported as such (exit 3), never as a mistake in the
+// input. (ASan reserves more address space than the limit allows.)
+TEST_F(Environment, OutOfMemoryIsExitThreeNotAnInputError) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
+#endif
+  {
+    std::ofstream big(Path("big.place"));
+    big << "Program Big\nUnits mm\nVacuum 8\nPoint P = XY(200, 20, -10, 0)\n\nFunction Main\n";
+    for (int i = 0; i < 30000; ++i) big << "  Jump P + X(1) + Y(2) + Z(3)\n";  // checked in 200 MB
+    big << "Fend\n";
+  }
+  // A valid program, in 150 MB of address space.
+  std::string command = fmt::format("cd {} && ulimit -v 150000 && {} check big.place >/dev/null 2>err.txt",
+                                    Quote(dir_.string()), Quote(SMTCAL_BINARY));
+  int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  EXPECT_EQ(test::ReadFileText(Path("err.txt")), "smtcal: error: out of memory\n");
+}
+
 // A file name with bytes that are not UTF-8 (legal on Linux) in every JSON
 // output and the SVG pictures: valid JSON and XML text, U+FFFD for the bytes.
 TEST_F(Environment, FileNamesThatAreNotUtf8) {
