@@ -31,7 +31,8 @@ SMTCAL_FUZZ_TARGET(points_csv) {
   std::uint32_t file = sources.Add("points.csv", std::string(fuzz::AsText(data, size)));
   std::optional<std::vector<PointRow>> points = ReadPoints(file, diags);
   if (points) {
-    for (const PointRow& row : *points) fuzz::Solve(*example->table, example->analysis, row.point);
+    static const fuzz::Solvers solvers(*example->table, example->analysis);
+    for (const PointRow& row : *points) fuzz::Solve(solvers, row.point);
   }
   diags.RenderText();
   return 0;

@@ -8,17 +8,23 @@
 
 namespace smtcal::fuzz {
 
-// Both inverse solvers and the forward map at `point`, every outside policy.
-// The default solver must converge within the bound proven for the table.
-inline void Solve(const ErrorTable& table, const TableAnalysis& analysis, const Eigen::Vector2d& point) {
-  InverseSolver solver(table, analysis);
-  PaperSolver paper(table, kPaperSolverTolMm);
-  CalibrationMap map(table);
+// Both inverse solvers and the forward map of one table, made once.
+struct Solvers {
+  Solvers(const ErrorTable& table, const TableAnalysis& analysis)
+      : inverse(table, analysis), paper(table, kPaperSolverTolMm), map(table) {}
+  InverseSolver inverse;
+  PaperSolver paper;
+  CalibrationMap map;
+};
+
+// Every solver at `point`, every outside policy. The default solver must
+// converge within the bound proven for the table.
+inline void Solve(const Solvers& solvers, const Eigen::Vector2d& point) {
   for (OutsidePolicy policy : {OutsidePolicy::kError, OutsidePolicy::kClamp, OutsidePolicy::kNone}) {
-    Solution s = solver.Solve(point, policy);
+    Solution s = solvers.inverse.Solve(point, policy);
     if (s.status == SolveStatus::kNotConverged) Fail("the default solver exceeded its proven bound");
-    paper.Solve(point, policy);
-    DirectCalibrate(map, point, policy);
+    solvers.paper.Solve(point, policy);
+    DirectCalibrate(solvers.map, point, policy);
   }
 }
 

@@ -29,9 +29,10 @@ SMTCAL_FUZZ_TARGET(table_csv) {
     PlotTableSvg(*table, "table.csv");
     FormatTableCsv(*table, {"fuzz"});
     const Rect domain = TableDomain(*table);
-    fuzz::Solve(*table, analysis, {(domain.x0 + domain.x1) / 2, (domain.y0 + domain.y1) / 2});
-    fuzz::Solve(*table, analysis, {domain.x0, domain.y1});
-    fuzz::Solve(*table, analysis, {domain.x1 + 1, domain.y0 - 1});
+    const fuzz::Solvers solvers(*table, analysis);
+    fuzz::Solve(solvers, {(domain.x0 + domain.x1) / 2, (domain.y0 + domain.y1) / 2});
+    fuzz::Solve(solvers, {domain.x0, domain.y1});
+    fuzz::Solve(solvers, {domain.x1 + 1, domain.y0 - 1});
   }
   diags.RenderText();
   diags.RenderJson();
