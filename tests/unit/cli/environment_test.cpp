@@ -247,6 +247,7 @@ TEST_F(Environment, FileNamesThatAreNotUtf8) {
     cell.replace(at, 9, absolute);
   }
   std::ofstream(Path(bad + ".cell.toml")) << cell;
+  fs::copy_file(kSource / "tests/golden/fixture/scan.csv", Path(bad + ".trips.csv"));
   const std::string program = Quote(bad + ".place");
   const std::string json_commands[] = {
       fmt::format("verify {} --cell {} --json", program, Quote(kCell)),
@@ -254,6 +255,8 @@ TEST_F(Environment, FileNamesThatAreNotUtf8) {
       fmt::format("table stats {} --json", Quote(bad + ".csv")),
       fmt::format("cell check {} --json", Quote(bad + ".cell.toml")),
       fmt::format("diff {} {} --json", program, program),
+      fmt::format("fixture --cell {} --fixture Board --trips {} --json",
+                  Quote((kSource / "tests/golden/fixture/data/board.cell.toml").string()), Quote(bad + ".trips.csv")),
   };
   for (const std::string& command : json_commands) {
     Run run = Smtcal(command);
