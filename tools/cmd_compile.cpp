@@ -9,6 +9,7 @@
 #include "backend/reports/compile_report.h"
 #include "calibration/cell.h"
 #include "frontend/parse.h"
+#include "ir/ir_ops.h"
 #include "passes/correction/compile_state.h"
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
@@ -36,7 +37,8 @@ ReportCounts Counts(const Diagnostics& diags) {
 // The corrected program says at its top what it is.
 void AddHeader(ir::Program& program, const cell::Cell& cell) {
   std::vector<std::string> lines = {
-      fmt::format(" Corrected by smtcal {} for cell '{}' ({}). Do not edit; compile the source again.", SMTCAL_VERSION,
+      fmt::format("{}{} for cell '{}' ({}). Do not edit; compile the source again.", ir::kCorrectedHeaderPrefix,
+                  SMTCAL_VERSION,
                   cell.name, cell.path),
       " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
       " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
@@ -71,6 +73,11 @@ std::string ProgramName(const ir::Program& program) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
+  if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
+      OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;

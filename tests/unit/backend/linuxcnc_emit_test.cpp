@@ -85,12 +85,14 @@ std::string ProbeReplacement(const std::vector<std::vector<Eigen::Vector2d>>& tr
   return out + "o<smtcal_probe_trips> endsub\n";
 }
 
-// Every fixture of the cell at a pose (nullopt: its nominal pose).
+// The trips every fixture of the cell records with its board at a pose
+// (nullopt: its nominal pose): where the robot is commanded when it really
+// is at the edge, as the cell's tables say (the runtime calibrates them back).
 std::vector<std::vector<Eigen::Vector2d>> TripsAt(const cell::Cell& cell,
                                                   const std::optional<Eigen::Affine3d>& pose = std::nullopt) {
   std::vector<std::vector<Eigen::Vector2d>> trips;
   for (const cell::Fixture& fixture : cell.fixtures) {
-    trips.push_back(NominalTrips(fixture, pose ? *pose : NominalFix(fixture)));
+    trips.push_back(CommandedTrips(fixture, cell.regions, pose ? *pose : NominalFix(fixture)));
   }
   return trips;
 }

@@ -526,7 +526,7 @@ TEST(LinuxCncRuntime, ExampleCellDataLoadsAndNominalTripsGiveTheNominalPose) {
   const Workspace ws("example", *cell, /*with_override_dir=*/true);
   const cell::Fixture& fixture = cell->fixtures[0];
   const Eigen::Affine3d nominal = NominalFix(fixture);
-  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(NominalTrips(fixture, nominal)));
+  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(CommandedTrips(fixture, cell->regions, nominal)));
   ws.Write("sub/smtcal_test_report.ngc", kReportSub);
   ws.Write("sub/smtcal_test_point.ngc", kPointSub);
   // A layer point on the board and a feeder position in the base frame.
@@ -571,15 +571,17 @@ TEST(LinuxCncRuntime, SecondScanIsCheckedAgainstTheFirstAndAbortsBeforePlacing) 
   ASSERT_TRUE(cell) << diagnostics;
   const Workspace ws("cycle", *cell, /*with_override_dir=*/true);
   const cell::Fixture& fixture = cell->fixtures[0];
-  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(NominalTrips(fixture, NominalFix(fixture))));
+  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(CommandedTrips(fixture, cell->regions, NominalFix(fixture))));
   // 1.5 mm and then -1 mm from nominal: each within max_shift_mm = 2 of
-  // nominal, but 2.5 mm from each other.
+  // nominal, but 2.5 mm from each other (commanded: the trips are
+  // direct-calibrated through the marker tables, whose slope makes the real
+  // move 2.4992 mm).
   const test::Rs274Result run = ws.Run(ProgramStart() +
                                        "#<_t_dx> = 1.5\no<smtcal_scan> call [0]\nM64 P7\n"
                                        "#<_t_dx> = -1\no<smtcal_scan> call [0]\nM64 P8\n" +
                                        ProgramEnd());
   EXPECT_EQ(run.exit_code, 1) << run.out;
-  EXPECT_NE(run.err.find("smtcal: marker scan of fixture 0 failed check cycle_shift: the origin moved 2.5000 mm "
+  EXPECT_NE(run.err.find("smtcal: marker scan of fixture 0 failed check cycle_shift: the origin moved 2.4992 mm "
                          "since the last scan, limit max_shift_mm 2.0000"),
             std::string::npos)
       << run.err;
