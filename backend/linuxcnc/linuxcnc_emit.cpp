@@ -31,6 +31,7 @@
 
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "ir/constant_fold.h"
 #include "ir/ir_text.h"
 #include "ir/ir_walk.h"
@@ -281,7 +282,7 @@ class Emitter {
   std::set<std::pair<std::uint32_t, std::uint32_t>> too_long_;  // statements reported
   void Abort(std::string_view message, SourceLoc loc) {
     // The abort's own text is the message; the location is inside it.
-    Emit(fmt::format("{}(abort, smtcal: {} at {})", std::string(static_cast<std::size_t>(indent_) * 2, ' '),
+    Emit(fmt::format("{}(abort,smtcal: {} at {})", std::string(static_cast<std::size_t>(indent_) * 2, ' '),
                      Sanitize(message), Sanitize(Where(loc))),
          loc);
   }
@@ -852,6 +853,7 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   output.main_text = std::move(*main);
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
+  output.subroutines.push_back({"smtcal_scan_abort.ngc", EmitLinuxCncScanAbort(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
             [](const EmbeddedFile& a, const EmbeddedFile& b) { return a.name < b.name; });
   return output;
@@ -860,7 +862,7 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
 std::string LinuxCncReviewText(const LinuxCncOutput& output) {
   std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, output.main_text);
   for (const EmbeddedFile& file : output.subroutines) {
-    if (file.name == "smtcal_data.ngc") text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
+    if (file.name == "smtcal_data.ngc" || file.name == "smtcal_scan_abort.ngc") text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
   }
   return text;
 }

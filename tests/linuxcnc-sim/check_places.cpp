@@ -1,0 +1,236 @@
+// check_places: what LinuxCNC did in a simulated run (run_scenario.py)
+// against smtcal's own C++ (README.md in this folder).
+//
+//   smtcal_linuxcnc_sim_check --program P.place --cell C.cell.toml --run check.json
+//
+// check.json, written by run_scenario.py: per cycle the board's true pose,
+// the trips LinuxCNC latched (by index), the `smtcal fixture --json` output
+// for them, and the machine's position at every Place (the vacuum valve
+// going off). For every cycle it prints and checks:
+//   trips    how far past its true marker edge each trip was latched, along
+//            the direction of travel (the sensor chain's latency; the edges
+//            are the markers' in the board's true frame, as the sensor HAL
+//            draws them);
+//   places   every Place the machine made against smtcal's C++ correction
+//            from the same trips: the cycle's Place targets in the order
+//            the compile-time trace runs them (the program's first cycle),
+//            FIX from `smtcal fixture`, FIX . f, the region's inverse
+//            (CompileState::SolverFor), u plus the board's angle;
+//   landing  where each part really lands: the command through the cell's
+//            tables (the robot's error as the cell describes it) into the
+//            board's true frame, against the programmed point.
+// Exit 0 when every place equals the C++ correction within kSameMm and lands
+// within its region's tolerance; 1 otherwise (2: usage or unreadable input).
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "calibration/fixture_estimation.h"
+#include "calibration/fixture_geometry.h"
+#include "passes/compile_pipeline.h"
+#include "passes/correction/compile_state.h"
+
+namespace smtcal {
+namespace {
+
+using nlohmann::json;
+
+// LinuxCNC computes the runtime in doubles as smtcal does, and its motion
+// controller ends a move on its target: a place agrees with the C++
+// correction to rounding (measured below 1e-12 mm). 1e-9 mm leaves room and
+// still tells any real difference.
+constexpr double kSameMm = 1e-9;
+constexpr double kSameDeg = 1e-9;
+
+struct Options {
+  std::string program, cell, run;
+};
+
+bool ParseArgs(int argc, char** argv, Options& options) {
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string key = argv[i];
+    if (key == "--program") options.program = argv[i + 1];
+    else if (key == "--cell") options.cell = argv[i + 1];
+    else if (key == "--run") options.run = argv[i + 1];
+    else return false;
+  }
+  return !options.program.empty() && !options.cell.empty() && !options.run.empty();
+}
+
+json ReadJson(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return json::parse(text.str());
+}
+
+Eigen::Affine3d FixFromScan(const json& scan) {
+  Eigen::Affine3d fix;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) fix.matrix()(r, c) = scan["fix"]["matrix"][r][c].get<double>();
+  }
+  return fix;
+}
+
+Eigen::Affine3d TruePose(const json& pose) {
+  return PlanarFix({pose["x_mm"].get<double>(), pose["y_mm"].get<double>()},
+                   Radians(pose["angle_deg"].get<double>()));
+}
+
+// The cycle's Place targets in the order the machine makes them.
+std::vector<const Target*> PlacesInOrder(const CompileState& state) {
+  std::vector<const Target*> places;
+  for (const auto& [cycle, events] : state.cycle_traces) {
+    for (const TraceEvent& event : events) {
+      const Target& target = state.targets[event.target];
+      if (event.kind == TraceEvent::Kind::kMotion && target.is_placement()) places.push_back(&target);
+    }
+  }
+  return places;
+}
+
+// The trips: how far past the true edge each was latched, along the leg.
+// Returns the largest.
+double CheckTrips(const cell::Fixture& fixture, const json& trips, const Eigen::Affine3d& truth) {
+  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
+  const double nominal_angle = FixAngleRad(NominalFix(fixture));
+  const double turn = nominal_angle - FixAngleRad(truth);  // legs run at the nominal pose
+  const Eigen::Rotation2Dd to_true(turn);
+  double largest = 0;
+  std::string line = "  trips past their true edge (mm):";
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const std::string key = std::to_string(k);
+    if (!trips.contains(key)) {
+      line += fmt::format(" {} -", TripName(k));
+      continue;
+    }
+    const Eigen::Vector2d base(trips[key][0].get<double>(), trips[key][1].get<double>());
+    const Eigen::Vector2d f = ToFixtureFrame(truth, base);
+    const EdgeLine edge = EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]);
+    const Eigen::Vector2d travel = to_true * expected[k].leg_direction;
+    const double past = (edge.normal.dot(f) - edge.offset) / edge.normal.dot(travel);
+    line += fmt::format(" {} {:.4f}", TripName(k), past);
+    largest = std::max(largest, std::abs(past));
+  }
+  std::cout << line << "\n";
+  return largest;
+}
+
+int Run(const Options& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Result<std::uint32_t> file = sources.Load(options.program);
+  if (!file) {
+    std::cerr << file.error().message << "\n";
+    return 2;
+  }
+  CompiledProgram compiled;
+  Result<bool> ran = CompileForCell(file.value(), options.cell, false, sources, diags, compiled);
+  if (!ran || !ran.value() || diags.has_errors()) {
+    std::cerr << diags.RenderText() << (ran ? "" : ran.error().message) << "\n";
+    return 2;
+  }
+  CompileState& state = *compiled.program.compile;
+  const cell::Cell& cell = *compiled.cell;
+  const cell::Fixture& fixture = cell.fixtures.at(0);
+  const std::vector<const Target*> places = PlacesInOrder(state);
+  const json run = ReadJson(options.run);
+
+  bool ok = true;
+  int cycle_number = 0;
+  for (const json& cycle : run["cycles"]) {
+    ++cycle_number;
+    const Eigen::Affine3d truth = TruePose(cycle["pose"]);
+    std::cout << fmt::format("cycle {}: board at x {:.4f} y {:.4f} angle {:.4f} deg{}\n", cycle_number,
+                             FixOrigin(truth).x(), FixOrigin(truth).y(), FixAngleRad(truth) * kDegPerRad,
+                             cycle["pose"].value("present", true) ? "" : " (no board)");
+    const double past = CheckTrips(fixture, cycle["trips"], truth);
+    std::cout << fmt::format("  largest trip past its edge: {:.4f} mm\n", past);
+    const json scan = ReadJson(cycle["scan"].get<std::string>());
+    const json& machine = cycle["places"];
+    if (!scan["ok"].get<bool>()) {
+      std::cout << fmt::format("  scan refused ({}): {} places\n", scan["fault"].get<std::string>(), machine.size());
+      if (!machine.empty()) {
+        std::cerr << fmt::format("cycle {}: the scan was refused, yet the machine placed {} parts\n", cycle_number,
+                                 machine.size());
+        ok = false;
+      }
+      continue;
+    }
+    const Eigen::Affine3d fix = FixFromScan(scan);
+    std::cout << fmt::format("  FIX from the latched trips: x {:.6f} y {:.6f} angle {:.6f} deg ({:+.4f} {:+.4f} "
+                             "mm, {:+.6f} deg from the true pose)\n",
+                             FixOrigin(fix).x(), FixOrigin(fix).y(), FixAngleRad(fix) * kDegPerRad,
+                             FixOrigin(fix).x() - FixOrigin(truth).x(), FixOrigin(fix).y() - FixOrigin(truth).y(),
+                             RelativeAngleRad(truth, fix) * kDegPerRad);
+    if (machine.size() != places.size()) {
+      std::cerr << fmt::format("cycle {}: the machine placed {} parts, the program places {}\n", cycle_number,
+                               machine.size(), places.size());
+      ok = false;
+      continue;
+    }
+    double worst_same = 0, worst_u = 0, worst_landing = 0, worst_share = 0;
+    for (std::size_t i = 0; i < places.size(); ++i) {
+      const Target& target = *places[i];
+      const std::string what = fmt::format("Place {} (line {})", target.text, target.stmt->loc.line);
+      const json& at = machine[i];  // x y z a b c, speed
+      const Eigen::Vector2d command(at[0].get<double>(), at[1].get<double>());
+      // smtcal's C++ correction from the same trips.
+      const Pose4 required = PoseToBase(fix, target.in_frame);
+      const cell::Region* region = cell.RegionAt(Xy(required));
+      if (region == nullptr) {
+        std::cerr << what << ": no region holds the required position\n";
+        ok = false;
+        continue;
+      }
+      const Solution solution = state.SolverFor(*region).Solve(Xy(required), region->outside);
+      const double same = (command - solution.point).norm();
+      const double du = std::abs(at[5].get<double>() - required[3]);
+      // Where the part lands: the command through the cell's tables, in the board's true frame.
+      const Eigen::Vector2d reached = DirectCalibrateInCell(cell.regions, command);
+      const double landing = (ToFixtureFrame(truth, reached) - Xy(target.in_frame)).norm();
+      worst_same = std::max(worst_same, same);
+      worst_u = std::max(worst_u, du);
+      worst_landing = std::max(worst_landing, landing);
+      worst_share = std::max(worst_share, landing / region->tolerance_mm);
+      const bool stands = at[6].get<double>() == 0 && std::abs(at[2].get<double>() - required[2]) < 1e-9;
+      if (same > kSameMm || du > kSameDeg || landing > region->tolerance_mm || !stands ||
+          solution.status != SolveStatus::kOk) {
+        std::cerr << fmt::format("cycle {}: {}: machine {:.9f} {:.9f} z {:.6f} u {:.9f} speed {}, C++ {:.9f} {:.9f} "
+                                 "u {:.9f} ({}), lands {:.4f} mm from its point (tolerance {} mm)\n",
+                                 cycle_number, what, command.x(), command.y(), at[2].get<double>(),
+                                 at[5].get<double>(), at[6].get<double>(), solution.point.x(), solution.point.y(),
+                                 required[3], StatusName(solution.status), landing, region->tolerance_mm);
+        ok = false;
+      }
+    }
+    std::cout << fmt::format("  {} places: largest difference to the C++ correction {:.2e} mm (u {:.2e} deg); "
+                             "largest landing error {:.4f} mm ({:.0f} % of the tolerance)\n",
+                             places.size(), worst_same, worst_u, worst_landing, 100 * worst_share);
+  }
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace smtcal
+
+int main(int argc, char** argv) {
+  smtcal::Options options;
+  if (!smtcal::ParseArgs(argc, argv, options)) {
+    std::fprintf(stderr, "usage: %s --program P.place --cell C.cell.toml --run check.json\n", argv[0]);
+    return 2;
+  }
+  try {
+    return smtcal::Run(options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
+    return 2;
+  }
+}
