@@ -330,7 +330,10 @@ TEST(LinuxCncEmit, OutputDirectoryHoldsTheProgramTheRuntimeAndTheData) {
   test::SmtcalRun review = test::RunSmtcal(
       fmt::format("compile {} --cell {} --target linuxcnc -o -", Quote(kExample), Quote(kCell)));
   ASSERT_EQ(review.exit_code, 0) << review.err;
-  EXPECT_EQ(review.out, "(smtcal file: layers.ngc)\n" + main + "(smtcal file: subroutines/smtcal_data.ngc)\n" + data);
+  const std::string aborts = test::ReadFileText(dir / "out" / "subroutines" / "smtcal_scan_abort.ngc");
+  EXPECT_NE(aborts.find("(abort,smtcal: marker scan of fixture Board failed check missing_trip: "), std::string::npos);
+  EXPECT_EQ(review.out, "(smtcal file: layers.ngc)\n" + main + "(smtcal file: subroutines/smtcal_data.ngc)\n" + data +
+                            "(smtcal file: subroutines/smtcal_scan_abort.ngc)\n" + aborts);
   fs::remove_all(dir);
 }
 

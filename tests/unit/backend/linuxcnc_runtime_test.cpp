@@ -599,10 +599,10 @@ TEST(LinuxCncRuntime, BadScanAbortsBeforeTheFirstPlacement) {
   // The real probe file: rs274's probe never trips.
   const test::Rs274Result run = ws.Run(ProgramStart() + "F600\no<smtcal_scan> call [0]\nM64 P8\n" + ProgramEnd());
   EXPECT_EQ(run.exit_code, 1) << run.out;
-  EXPECT_NE(run.err.find("smtcal: marker scan of fixture Board failed check missing_trip: 8 trips missing, the first T1, "
-                         "limit 0"),
+  EXPECT_NE(run.err.find("\nsmtcal: marker scan of fixture Board failed check missing_trip: 8 trips missing, the first "
+                         "T1, limit 0\n"),
             std::string::npos)
-      << run.err;
+      << "the message on a line of its own, no leading space: " << run.err;
   for (const std::string& line : run.canon) EXPECT_EQ(line.find("SET_AUX_OUTPUT_BIT"), std::string::npos) << line;
   // The scan: the first probe of each path toward its first leg's end at the
   // scan z, entering a marker (G38.3 prints no direction; its target is the
