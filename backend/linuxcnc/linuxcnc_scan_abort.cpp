@@ -27,10 +27,9 @@ constexpr std::array<std::string_view, 11> kMessages = {
     "cycle_rotation: turned %.4f#3 deg since the last scan, limit max_rotation_deg %.4f#4",
 };
 
-// A fixture name as message text: rs274 would end the comment at ')',
-// substitute after '#' and '%', and take ',' after a command word; anything
-// but letters, digits, '_', '-' and '.' is written as '_'.
-std::string MessageName(std::string_view name) {
+}  // namespace
+
+std::string LinuxCncMessageName(std::string_view name) {
   std::string out;
   for (char c : name) {
     const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
@@ -40,8 +39,6 @@ std::string MessageName(std::string_view name) {
   return out;
 }
 
-}  // namespace
-
 std::string EmitLinuxCncScanAbort(const cell::Cell& cell) {
   std::string out = fmt::format(
       "; smtcal_scan_abort.ngc - written by smtcal for the cell {} (runtime/linuxcnc/README.md).\n"
@@ -49,9 +46,9 @@ std::string EmitLinuxCncScanAbort(const cell::Cell& cell) {
       "; with the message of check `code` (1..11) for fixture k, naming the fixture.\n"
       "; Called by smtcal_scan_failed; a message is fixed text, so the names are here.\n"
       "o<smtcal_scan_abort> sub\n",
-      MessageName(cell.name));
+      LinuxCncMessageName(cell.name));
   for (std::size_t k = 0; k < cell.fixtures.size(); ++k) {
-    const std::string name = MessageName(cell.fixtures[k].name);
+    const std::string name = LinuxCncMessageName(cell.fixtures[k].name);
     out += fmt::format("o<smtcal_sa_fixture_{0}> if [#1 EQ {0}]\n", k);
     for (std::size_t code = 1; code <= kMessages.size(); ++code) {
       out += fmt::format("  o<smtcal_sa_code_{}> {} [#2 EQ {}]\n", k, code == 1 ? "if" : "elseif", code);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "calibration/cell.h"
 
@@ -15,5 +16,10 @@ namespace smtcal {
 
 // The text of smtcal_scan_abort.ngc for the cell (deterministic).
 std::string EmitLinuxCncScanAbort(const cell::Cell& cell);
+
+// A name as text of an rs274 message: rs274 would end the comment at ')',
+// substitute after '#' and '%', and take ',' after a command word; anything
+// but letters, digits, '_', '-' and '.' is written as '_'.
+std::string LinuxCncMessageName(std::string_view name);
 
 }  // namespace smtcal

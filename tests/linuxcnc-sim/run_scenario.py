@@ -82,6 +82,9 @@ SCENARIOS = {
                     "cycles": [pose(-0.45, 0.3), pose(0.45, -0.3)]},
     "cycle_rotation": {"program": SIM, "expect": "cycle_rotation",
                        "cycles": [pose(turn_deg=-0.3), pose(turn_deg=0.25)]},
+    # The dry-run probe file (compile --dry-run-probe) first on the machine's
+    # path by mistake: it must abort before the first move.
+    "dry_run_on_machine": {"program": SIM, "expect": "dry_run_refused", "dry_run": True, "cycles": [pose()]},
     # Opt-in (the linuxcnc-sim-full target): the shipped example, 40 parts a
     # cycle, three boards.
     "example_three_boards": {"program": EXAMPLE_PROGRAM, "expect": "ok",
@@ -131,7 +134,7 @@ def check_prerequisites():
 
 # ------------------------------------------------------------------ the machine
 
-def derive_ini(work, program_dir):
+def derive_ini(work, program_dir, dry_run):
     """paper-cell.ini made headless, with the sensor HAL and the program's subroutines."""
     lines = open(os.path.join(EXAMPLE, "paper-cell.ini")).read().splitlines()
     out, section = [], ""
@@ -146,6 +149,8 @@ def derive_ini(work, program_dir):
             continue  # popimage needs X
         elif section == "[RS274NGC]" and key == "SUBROUTINE_PATH":
             line = "SUBROUTINE_PATH = " + os.path.join(program_dir, "subroutines")
+            if dry_run:
+                line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
             out.append("HALFILE = " + os.path.join(HERE, "marker-sensor.hal"))
@@ -250,12 +255,12 @@ def main():
         cell = os.path.join(cell_dir, os.path.basename(CELL))
         open(cell, "w").write(text)
     program_dir = os.path.join(work, "program")
-    compiled = smtcal(["compile", scenario["program"], "--cell", cell, "--target", "linuxcnc", "-o", program_dir],
-                      args.smtcal)
+    compiled = smtcal(["compile", scenario["program"], "--cell", cell, "--target", "linuxcnc", "-o", program_dir]
+                      + (["--dry-run-probe"] if scenario.get("dry_run") else []), args.smtcal)
     if compiled.returncode != 0:
         fail("smtcal compile: " + compiled.stderr)
     stem = os.path.splitext(os.path.basename(scenario["program"]))[0]
-    ini = derive_ini(work, program_dir)
+    ini = derive_ini(work, program_dir, scenario.get("dry_run", False))
     plan = {"program": os.path.join(program_dir, stem + ".ngc"), "cycles": scenario["cycles"],
             "timeout_s": 120 + 100 * len(scenario["cycles"])}
     plan_path = os.path.join(work, "plan.json")
@@ -275,6 +280,11 @@ def main():
         f"run ended: {record['end']}")
     if record["end"].startswith("timeout"):
         fail(record["end"])
+
+    if scenario["expect"] == "dry_run_refused":
+        check_dry_run_refused(record)
+        log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
+        return
 
     # Per cycle: the latched trips, smtcal fixture's verdict on them.
     paths = trip_paths(args.smtcal, work)
@@ -323,6 +333,17 @@ def main():
     else:
         check_refusal(scenario, record, last, aborts)
     log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
+
+
+def check_dry_run_refused(record):
+    texts = [m["text"] for m in record["messages"]]
+    wanted = "smtcal: the dry-run probe file is on this machine's subroutine path"
+    if not any(t.startswith(wanted) for t in texts):
+        fail(f"expected the dry-run probe file to abort on the machine; messages: {texts}")
+    probes = sum(len(c["probes"]) for c in record["cycles"])
+    if probes or record["vacuum"]:
+        fail(f"the machine moved the sensor ({probes} probe moves) or the valve ({record['vacuum']})")
+    log(f"  refused: {texts[0]}")
 
 
 def check_refusal(scenario, record, verdict, aborts):
