@@ -1,7 +1,7 @@
 // check_places: what LinuxCNC did in a simulated run (run_scenario.py)
 // against smtcal's own C++ (README.md in this folder).
 //
-//   smtcal_linuxcnc_sim_check --program P.place --cell C.cell.toml --run check.json
+//   smtcal_linuxcnc_sim_check --program P.place --cell C.cell.toml --run check.json --servo-period-s T
 //
 // check.json, written by run_scenario.py: per cycle the board's true pose,
 // the trips LinuxCNC latched (by index), the `smtcal fixture --json` output
@@ -10,7 +10,12 @@
 //   trips    how far past its true marker edge each trip was latched, along
 //            the direction of travel (the sensor chain's latency; the edges
 //            are the markers' in the board's true frame, as the sensor HAL
-//            draws them);
+//            draws them); a scan that passed must have every trip latched
+//            at or past its edge and at most one servo period's travel at
+//            the scan speed past it (the sensor HAL runs after the motion
+//            controller in the servo thread, from the position motion just
+//            commanded; motion reads the input in the next period and
+//            latches that position);
 //   places   every Place the machine made against smtcal's C++ correction
 //            from the same trips: the cycle's Place targets in the order
 //            the compile-time trace runs them (the program's first cycle),
@@ -22,6 +27,7 @@
 // Exit 0 when every place equals the C++ correction within kSameMm and lands
 // within its region's tolerance; 1 otherwise (2: usage or unreadable input).
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -51,6 +57,7 @@ constexpr double kSameDeg = 1e-9;
 
 struct Options {
   std::string program, cell, run;
+  double servo_period_s = 0;
 };
 
 bool ParseArgs(int argc, char** argv, Options& options) {
@@ -59,9 +66,10 @@ bool ParseArgs(int argc, char** argv, Options& options) {
     if (key == "--program") options.program = argv[i + 1];
     else if (key == "--cell") options.cell = argv[i + 1];
     else if (key == "--run") options.run = argv[i + 1];
+    else if (key == "--servo-period-s") options.servo_period_s = std::atof(argv[i + 1]);
     else return false;
   }
-  return !options.program.empty() && !options.cell.empty() && !options.run.empty();
+  return !options.program.empty() && !options.cell.empty() && !options.run.empty() && options.servo_period_s > 0;
 }
 
 json ReadJson(const std::string& path) {
@@ -97,13 +105,15 @@ std::vector<const Target*> PlacesInOrder(const CompileState& state) {
 }
 
 // The trips: how far past the true edge each was latched, along the leg.
-// Returns the largest.
-double CheckTrips(const cell::Fixture& fixture, const json& trips, const Eigen::Affine3d& truth) {
+struct TripLatency {
+  double smallest = 0, largest = 0;
+};
+TripLatency CheckTrips(const cell::Fixture& fixture, const json& trips, const Eigen::Affine3d& truth) {
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const double nominal_angle = FixAngleRad(NominalFix(fixture));
   const double turn = nominal_angle - FixAngleRad(truth);  // legs run at the nominal pose
   const Eigen::Rotation2Dd to_true(turn);
-  double largest = 0;
+  TripLatency latency{1e300, -1e300};
   std::string line = "  trips past their true edge (mm):";
   for (std::size_t k = 0; k < expected.size(); ++k) {
     const std::string key = std::to_string(k);
@@ -117,10 +127,11 @@ double CheckTrips(const cell::Fixture& fixture, const json& trips, const Eigen::
     const Eigen::Vector2d travel = to_true * expected[k].leg_direction;
     const double past = (edge.normal.dot(f) - edge.offset) / edge.normal.dot(travel);
     line += fmt::format(" {} {:.4f}", TripName(k), past);
-    largest = std::max(largest, std::abs(past));
+    latency.smallest = std::min(latency.smallest, past);
+    latency.largest = std::max(latency.largest, past);
   }
   std::cout << line << "\n";
-  return largest;
+  return latency;
 }
 
 int Run(const Options& options) {
@@ -151,9 +162,22 @@ int Run(const Options& options) {
     std::cout << fmt::format("cycle {}: board at x {:.4f} y {:.4f} angle {:.4f} deg{}\n", cycle_number,
                              FixOrigin(truth).x(), FixOrigin(truth).y(), FixAngleRad(truth) * kDegPerRad,
                              cycle["pose"].value("present", true) ? "" : " (no board)");
-    const double past = CheckTrips(fixture, cycle["trips"], truth);
-    std::cout << fmt::format("  largest trip past its edge: {:.4f} mm\n", past);
+    const TripLatency past = CheckTrips(fixture, cycle["trips"], truth);
     const json scan = ReadJson(cycle["scan"].get<std::string>());
+    const double speed = fixture.scan_speed_mm_s;
+    const double bound = speed * options.servo_period_s + 1e-9;
+    if (past.largest >= past.smallest) {
+      std::cout << fmt::format("  trips latched {:.4f} to {:.4f} mm past their edges at {} mm/s ({:.2f} to {:.2f} "
+                               "servo periods)\n",
+                               past.smallest, past.largest, speed, past.smallest / (speed * options.servo_period_s),
+                               past.largest / (speed * options.servo_period_s));
+      if (scan["ok"].get<bool>() && (past.smallest < 0 || past.largest > bound)) {
+        std::cerr << fmt::format("cycle {}: a trip latched {:.4f} mm before or {:.4f} mm past its edge; expected 0 "
+                                 "to {:.4f} mm (one servo period at {} mm/s)\n",
+                                 cycle_number, past.smallest, past.largest, bound, speed);
+        ok = false;
+      }
+    }
     const json& machine = cycle["places"];
     if (!scan["ok"].get<bool>()) {
       std::cout << fmt::format("  scan refused ({}): {} places\n", scan["fault"].get<std::string>(), machine.size());
@@ -224,7 +248,8 @@ int Run(const Options& options) {
 int main(int argc, char** argv) {
   smtcal::Options options;
   if (!smtcal::ParseArgs(argc, argv, options)) {
-    std::fprintf(stderr, "usage: %s --program P.place --cell C.cell.toml --run check.json\n", argv[0]);
+    std::fprintf(stderr, "usage: %s --program P.place --cell C.cell.toml --run check.json --servo-period-s T\n",
+                 argv[0]);
     return 2;
   }
   try {

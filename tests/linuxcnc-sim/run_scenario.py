@@ -314,7 +314,9 @@ def main():
     json.dump({"cycles": check_cycles}, open(check_input, "w"), indent=1)
 
     # The machine against smtcal's C++: trips, places, landing.
-    checked = run([args.checker, "--program", scenario["program"], "--cell", cell, "--run", check_input])
+    servo_period_s = int(re.search(r"(?m)^SERVO_PERIOD = (\d+)", open(ini).read()).group(1)) * 1e-9
+    checked = run([args.checker, "--program", scenario["program"], "--cell", cell, "--run", check_input,
+                   "--servo-period-s", repr(servo_period_s)])
     log(checked.stdout.rstrip())
     if checked.returncode != 0:
         fail("the checker found differences:\n" + checked.stderr)
