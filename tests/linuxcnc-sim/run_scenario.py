@@ -126,9 +126,9 @@ def check_prerequisites():
     if probe.returncode != 0:
         skip("the Python module 'linuxcnc' is missing for /usr/bin/python3 (package linuxcnc-uspace): "
              + probe.stderr.strip().splitlines()[-1])
-    ns = run(["unshare", "--pid", "--fork", "--kill-child", "--mount-proc", "--ipc", "--mount", "true"])
+    ns = run(["unshare", "--pid", "--fork", "--kill-child", "--mount-proc", "--ipc", "--mount", "--net", "true"])
     if ns.returncode != 0:
-        skip("new PID/IPC/mount namespaces are not allowed here (unshare: %s); LinuxCNC's shutdown would "
+        skip("new PID/IPC/mount/network namespaces are not allowed here (unshare: %s); LinuxCNC's shutdown would "
              "kill processes and remove shared memory outside the test" % ns.stderr.strip())
 
 
@@ -176,6 +176,76 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
             "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini]
     with open(os.path.join(work, "linuxcnc.log"), "w") as log_file:
         return subprocess.run(argv, env=env, stdout=log_file, stderr=subprocess.STDOUT).returncode
+
+
+# ------------------------------------------------------------------ the example as shipped
+
+# examples/linuxcnc/README.md, "Run it without a screen": the steps a user
+# sends to linuxcncrsh (port 5007), homing included.
+README_STEPS = ["hello EMC client 1.0", "set enable EMCTOO", "set set_wait done", "set estop off",
+                "set machine on", "set mode manual", "set home -1", "set mode auto",
+                "set open layers/layers.ngc", "set run"]
+
+CLIENT = """
+import socket, sys, time
+steps = sys.argv[1].split("|")
+for attempt in range(300):
+    try:
+        s = socket.create_connection(("127.0.0.1", 5007))
+        break
+    except OSError:
+        time.sleep(0.1)
+f = s.makefile("rw")
+for step in steps:
+    f.write(step + "\\r\\n")
+    f.flush()
+    time.sleep(1.0 if step in ("set home -1", "set run") else 0.2)
+s.settimeout(0.5)
+out, end = "", time.time() + 60
+while time.time() < end and "marker scan" not in out:
+    f.write("get error\\r\\n")
+    f.flush()
+    time.sleep(0.5)
+    try:
+        out += s.recv(65536).decode()
+    except socket.timeout:
+        pass
+print(out)
+f.write("shutdown\\r\\n")
+f.flush()
+"""
+
+
+def headless_example(args):
+    """paper-cell-headless.ini as shipped, driven through linuxcncrsh as the README says."""
+    work = os.path.join(os.path.abspath(args.work), args.scenario)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    for name in os.listdir(EXAMPLE):
+        if name.startswith("paper-cell"):
+            shutil.copy(os.path.join(EXAMPLE, name), work)
+    compiled = smtcal(["compile", EXAMPLE_PROGRAM, "--cell", CELL, "--target", "linuxcnc", "-o",
+                       os.path.join(work, "layers")], args.smtcal)
+    if compiled.returncode != 0:
+        fail("smtcal compile: " + compiled.stderr)
+    tmp = os.path.join(work, "tmp")
+    os.makedirs(tmp)
+    os.chmod(tmp, 0o1777)
+    env = dict(os.environ, RTAPI_UID="65534", RTAPI_FIFO_PATH="/tmp/rtapi_fifo", HOME=work)
+    env.pop("DISPLAY", None)
+    # Its own network namespace too: linuxcncrsh listens on port 5007.
+    inner = ('mount --bind "$0" /tmp && ip link set lo up && cd "$1" && '
+             '{ linuxcnc paper-cell-headless.ini > linuxcnc.log 2>&1 & } && exec /usr/bin/python3 -c "$2" "$3"')
+    result = run(["timeout", "-k", "10", "120", "unshare", "--pid", "--fork", "--kill-child", "--mount-proc",
+                  "--ipc", "--mount", "--net", "sh", "-c", inner, tmp, work, CLIENT, "|".join(README_STEPS)],
+                 env=env)
+    want = "ERROR smtcal: marker scan of fixture Board failed check missing_trip: 8 trips missing"
+    if want not in result.stdout:
+        log_text = open(os.path.join(work, "linuxcnc.log")).read()[-3000:] if os.path.exists(
+            os.path.join(work, "linuxcnc.log")) else ""
+        fail(f"expected '{want}' from linuxcncrsh; got:\n{result.stdout[-2000:]}{result.stderr}\n{log_text}")
+    log("paper-cell-headless.ini as shipped: linuxcncrsh homed the machine and ran layers.ngc; with no sensor "
+        "wired the first scan aborted:\n  " + next(l for l in result.stdout.splitlines() if "marker scan" in l))
 
 
 # ------------------------------------------------------------------ smtcal
@@ -230,10 +300,12 @@ def main():
     parser.add_argument("--smtcal", required=True)
     parser.add_argument("--checker", required=True)
     parser.add_argument("--work", required=True)
-    parser.add_argument("scenario", choices=sorted(SCENARIOS))
+    parser.add_argument("scenario", choices=sorted(SCENARIOS) + ["headless_example"])
     args = parser.parse_args()
-    scenario = SCENARIOS[args.scenario]
     check_prerequisites()
+    if args.scenario == "headless_example":
+        return headless_example(args)
+    scenario = SCENARIOS[args.scenario]
     started = time.monotonic()
 
     work = os.path.join(os.path.abspath(args.work), args.scenario)
