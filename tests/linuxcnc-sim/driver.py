@@ -143,7 +143,7 @@ def main():
                     end = "stopped after %d cycles" % next_cycle
         if stat.interp_state != linuxcnc.INTERP_IDLE:
             running_seen = True
-        elif running_seen:
+        elif running_seen or record["messages"]:
             end = "program ended" if not record["messages"] else "program aborted"
         if end is None and not clamped and cycle is None and next_cycle < len(cycles) and not stat.dout[RELEASE_OUT]:
             # The next board arrives at its true pose and is clamped.
