@@ -218,6 +218,8 @@ f.flush()
 
 def headless_example(args):
     """paper-cell-headless.ini as shipped, driven through linuxcncrsh as the README says."""
+    if shutil.which("ip") is None or shutil.which("linuxcncrsh") is None:
+        skip("'ip' (iproute2) or 'linuxcncrsh' (linuxcnc-uspace) is not installed (tools/install-deps.sh)")
     work = os.path.join(os.path.abspath(args.work), args.scenario)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
