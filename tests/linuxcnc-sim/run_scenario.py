@@ -250,6 +250,19 @@ def headless_example(args):
         "wired the first scan aborted:\n  " + next(l for l in result.stdout.splitlines() if "marker scan" in l))
 
 
+def leftover_processes(marker):
+    """Processes still running with `marker` in their environment (none: the
+    PID namespace took every process of the run with it)."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            if marker.encode() in open(f"/proc/{pid}/environ", "rb").read():
+                found.append(pid + " " + open(f"/proc/{pid}/cmdline", "rb").read().replace(b"\0", b" ").decode())
+        except OSError:
+            pass
+    return found
+
+
 # ------------------------------------------------------------------ smtcal
 
 def smtcal(args, binary, **kwargs):
@@ -343,6 +356,9 @@ def main():
     machine_started = time.monotonic()
     code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
     machine_s = time.monotonic() - machine_started
+    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
+    if left:
+        fail("processes of the run outlived it: " + "; ".join(left))
     if not os.path.exists(run_path):
         tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
         if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
