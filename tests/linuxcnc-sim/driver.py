@@ -19,8 +19,10 @@
 #            (probed_position, the #5061.. the runtime reads) and whether it
 #            tripped; a new result is a change of the position;
 #   vacuum   every change of the vacuum valve (motion.digital-out-08) with the
-#            commanded position and speed at that moment: on = a Pick, off =
-#            a Place (M64/M65 wait until the machine stands);
+#            commanded position and speed at the first status update that
+#            shows it: on = a Pick, off = a Place (M64/M65 wait until the
+#            machine stands; on a loaded host the update can come as the
+#            next move, the rise in z, begins);
 #   messages every operator message (an abort is one).
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
