@@ -26,6 +26,14 @@
 //            board's true frame, against the programmed point.
 // Exit 0 when every place equals the C++ correction within kSameMm and lands
 // within its region's tolerance; 1 otherwise (2: usage or unreadable input).
+//
+//   smtcal_linuxcnc_sim_check --cell C.cell.toml --sensor-model
+//
+// prints (JSON) where the simulated robot really puts the sensor around each
+// scan path: the cell's direct calibration (the tables of the regions over
+// the markers, none: the identity) fitted by an affine map A(p) = M p + b
+// over the path's area, for the sensor HAL's sum2 gains (driver.py), with
+// the fit's largest error. The trips' check above uses the same A.
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -40,6 +48,7 @@
 
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
+#include "frontend/cell_toml.h"
 #include "passes/compile_pipeline.h"
 #include "passes/correction/compile_state.h"
 
@@ -58,9 +67,15 @@ constexpr double kSameDeg = 1e-9;
 struct Options {
   std::string program, cell, run;
   double servo_period_s = 0;
+  bool sensor_model = false;
 };
 
 bool ParseArgs(int argc, char** argv, Options& options) {
+  if (argc == 4 && std::string(argv[1]) == "--cell" && std::string(argv[3]) == "--sensor-model") {
+    options.cell = argv[2];
+    options.sensor_model = true;
+    return true;
+  }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--program") options.program = argv[i + 1];
@@ -92,6 +107,52 @@ Eigen::Affine3d TruePose(const json& pose) {
                    Radians(pose["angle_deg"].get<double>()));
 }
 
+// An affine map of base positions: where the sensor really is for a command.
+struct SensorModel {
+  Eigen::Matrix2d m = Eigen::Matrix2d::Identity();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  double max_error_mm = 0;
+  Eigen::Vector2d operator()(const Eigen::Vector2d& p) const { return m * p + b; }
+};
+
+// The cell's direct calibration fitted by an affine map over scan path
+// `path` (its points at the nominal pose, widened by the trip window), on an
+// 11 x 11 grid, least squares.
+SensorModel FitSensorModel(const cell::Cell& cell, const cell::Fixture& fixture, std::size_t path) {
+  const std::vector<Eigen::Vector2d> points = ScanPathsInBase(fixture, NominalFix(fixture))[path];
+  Eigen::Vector2d lo = points.front(), hi = points.front();
+  for (const Eigen::Vector2d& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  lo.array() -= fixture.trip_window_mm;
+  hi.array() += fixture.trip_window_mm;
+  constexpr int kGrid = 11;
+  Eigen::MatrixXd a(kGrid * kGrid, 3);
+  Eigen::MatrixXd f(kGrid * kGrid, 2);
+  for (int i = 0; i < kGrid; ++i) {
+    for (int j = 0; j < kGrid; ++j) {
+      const Eigen::Vector2d p = lo + (hi - lo).cwiseProduct(Eigen::Vector2d(i, j) / (kGrid - 1));
+      a.row(i * kGrid + j) << p.x(), p.y(), 1;
+      f.row(i * kGrid + j) = DirectCalibrateInCell(cell.regions, p).transpose();
+    }
+  }
+  const Eigen::MatrixXd x = a.colPivHouseholderQr().solve(f);  // 3 x 2
+  SensorModel model;
+  model.m = x.topRows<2>().transpose();
+  model.b = x.row(2).transpose();
+  model.max_error_mm = (a * x - f).rowwise().norm().maxCoeff();
+  return model;
+}
+
+std::vector<SensorModel> SensorModels(const cell::Cell& cell, const cell::Fixture& fixture) {
+  std::vector<SensorModel> models;
+  for (std::size_t path = 0; path < fixture.scan_paths.size(); ++path) {
+    models.push_back(FitSensorModel(cell, fixture, path));
+  }
+  return models;
+}
+
 // The cycle's Place targets in the order the machine makes them.
 std::vector<const Target*> PlacesInOrder(const CompileState& state) {
   std::vector<const Target*> places;
@@ -108,7 +169,8 @@ std::vector<const Target*> PlacesInOrder(const CompileState& state) {
 struct TripLatency {
   double smallest = 0, largest = 0;
 };
-TripLatency CheckTrips(const cell::Fixture& fixture, const json& trips, const Eigen::Affine3d& truth) {
+TripLatency CheckTrips(const cell::Fixture& fixture, const std::vector<SensorModel>& sensor, const json& trips,
+                       const Eigen::Affine3d& truth) {
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const double nominal_angle = FixAngleRad(NominalFix(fixture));
   const double turn = nominal_angle - FixAngleRad(truth);  // legs run at the nominal pose
@@ -122,7 +184,7 @@ TripLatency CheckTrips(const cell::Fixture& fixture, const json& trips, const Ei
       continue;
     }
     const Eigen::Vector2d base(trips[key][0].get<double>(), trips[key][1].get<double>());
-    const Eigen::Vector2d f = ToFixtureFrame(truth, base);
+    const Eigen::Vector2d f = ToFixtureFrame(truth, sensor[expected[k].path](base));  // where the sensor was
     const EdgeLine edge = EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]);
     const Eigen::Vector2d travel = to_true * expected[k].leg_direction;
     const double past = (edge.normal.dot(f) - edge.offset) / edge.normal.dot(travel);
@@ -152,6 +214,7 @@ int Run(const Options& options) {
   const cell::Cell& cell = *compiled.cell;
   const cell::Fixture& fixture = cell.fixtures.at(0);
   const std::vector<const Target*> places = PlacesInOrder(state);
+  const std::vector<SensorModel> sensor = SensorModels(cell, fixture);
   const json run = ReadJson(options.run);
 
   bool ok = true;
@@ -162,16 +225,19 @@ int Run(const Options& options) {
     std::cout << fmt::format("cycle {}: board at x {:.4f} y {:.4f} angle {:.4f} deg{}\n", cycle_number,
                              FixOrigin(truth).x(), FixOrigin(truth).y(), FixAngleRad(truth) * kDegPerRad,
                              cycle["pose"].value("present", true) ? "" : " (no board)");
-    const TripLatency past = CheckTrips(fixture, cycle["trips"], truth);
+    const TripLatency past = CheckTrips(fixture, sensor, cycle["trips"], truth);
     const json scan = ReadJson(cycle["scan"].get<std::string>());
     const double speed = fixture.scan_speed_mm_s;
-    const double bound = speed * options.servo_period_s + 1e-9;
+    // The sensor HAL's affine model of the tables is that far off at most.
+    double model_error = 0;
+    for (const SensorModel& model : sensor) model_error = std::max(model_error, model.max_error_mm);
+    const double bound = speed * options.servo_period_s + model_error + 1e-9;
     if (past.largest >= past.smallest) {
       std::cout << fmt::format("  trips latched {:.4f} to {:.4f} mm past their edges at {} mm/s ({:.2f} to {:.2f} "
                                "servo periods)\n",
                                past.smallest, past.largest, speed, past.smallest / (speed * options.servo_period_s),
                                past.largest / (speed * options.servo_period_s));
-      if (scan["ok"].get<bool>() && (past.smallest < 0 || past.largest > bound)) {
+      if (scan["ok"].get<bool>() && (past.smallest < -model_error - 1e-9 || past.largest > bound)) {
         std::cerr << fmt::format("cycle {}: a trip latched {:.4f} mm before or {:.4f} mm past its edge; expected 0 "
                                  "to {:.4f} mm (one servo period at {} mm/s)\n",
                                  cycle_number, past.smallest, past.largest, bound, speed);
@@ -244,6 +310,26 @@ int Run(const Options& options) {
   return ok ? 0 : 1;
 }
 
+// --sensor-model: the fits as JSON, one per scan path.
+int PrintSensorModels(const Options& options) {
+  SourceManager sources;
+  Diagnostics diags(sources);
+  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(options.cell, sources, diags);
+  if (!loaded || !loaded.value()) {
+    std::cerr << diags.RenderText() << "\n";
+    return 2;
+  }
+  const cell::Cell& cell = *loaded.value();
+  json out = json::array();
+  for (const SensorModel& model : SensorModels(cell, cell.fixtures.at(0))) {
+    out.push_back({{"m", {{model.m(0, 0), model.m(0, 1)}, {model.m(1, 0), model.m(1, 1)}}},
+                   {"b", {model.b.x(), model.b.y()}},
+                   {"max_error_mm", model.max_error_mm}});
+  }
+  std::cout << out.dump(1) << "\n";
+  return 0;
+}
+
 }  // namespace
 }  // namespace smtcal
 
@@ -255,7 +341,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    return smtcal::Run(options);
+    return options.sensor_model ? smtcal::PrintSensorModels(options) : smtcal::Run(options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s\n", argv[0], e.what());
     return 2;

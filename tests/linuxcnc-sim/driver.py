@@ -43,14 +43,25 @@ def hal(commands):
     subprocess.run(["halcmd", "-f"], input="\n".join(commands) + "\n", text=True, check=True)
 
 
-def place_board(pose):
-    """The board's true pose for the sensor HAL (marker-sensor.hal)."""
+def place_board(pose, sensor_models):
+    """The board's true pose for the sensor HAL (marker-sensor.hal): per
+    marker k, f = R(a)^T (M p + b - o) into sum2.(2k) and sum2.(2k+1), where
+    M p + b is where the robot really puts the sensor for a command p."""
     a = math.radians(pose["angle_deg"])
     c, s = math.cos(a), math.sin(a)
-    ox, oy = pose["x_mm"], pose["y_mm"]
-    hal([f"setp sum2.0.gain0 {c!r}", f"setp sum2.0.gain1 {s!r}", f"setp sum2.0.offset {-(c * ox + s * oy)!r}",
-         f"setp sum2.1.gain0 {-s!r}", f"setp sum2.1.gain1 {c!r}", f"setp sum2.1.offset {s * ox - c * oy!r}",
-         f"sets board-present {'true' if pose.get('present', True) else 'false'}"])
+    o = (pose["x_mm"], pose["y_mm"])
+    commands = [f"sets board-present {'true' if pose.get('present', True) else 'false'}"]
+    for k, model in enumerate(sensor_models):
+        m, b = model["m"], model["b"]
+        rt = ((c, s), (-s, c))  # R(a)^T
+        for row in range(2):
+            g0 = rt[row][0] * m[0][0] + rt[row][1] * m[1][0]
+            g1 = rt[row][0] * m[0][1] + rt[row][1] * m[1][1]
+            offset = rt[row][0] * (b[0] - o[0]) + rt[row][1] * (b[1] - o[1])
+            unit = 2 * k + row
+            commands += [f"setp sum2.{unit}.gain0 {g0!r}", f"setp sum2.{unit}.gain1 {g1!r}",
+                         f"setp sum2.{unit}.offset {offset!r}"]
+    hal(commands)
 
 
 def main():
@@ -150,7 +161,7 @@ def main():
         if end is None and not clamped and cycle is None and next_cycle < len(cycles) and not stat.dout[RELEASE_OUT]:
             # The next board arrives at its true pose and is clamped.
             pose = cycles[next_cycle]
-            place_board(pose)
+            place_board(pose, plan["sensor_models"])
             hal(["sets transport-clamped true"])
             clamped = True
             cycle = {"pose": pose, "clamped_s": now(), "probes": []}

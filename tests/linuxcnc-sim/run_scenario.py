@@ -348,8 +348,15 @@ def main():
         fail("smtcal compile: " + compiled.stderr)
     stem = os.path.splitext(os.path.basename(scenario["program"]))[0]
     ini = derive_ini(work, program_dir, scenario.get("dry_run", False))
+    # Where the robot really puts the sensor around each marker (the cell's tables there, affine).
+    model = run([args.checker, "--cell", cell, "--sensor-model"])
+    if model.returncode != 0:
+        fail("the checker's sensor model: " + model.stderr)
+    sensor_models = json.loads(model.stdout)
+    if len(sensor_models) != 2:
+        fail(f"the sensor HAL has two markers; the cell's fixture has {len(sensor_models)} scan paths")
     plan = {"program": os.path.join(program_dir, stem + ".ngc"), "cycles": scenario["cycles"],
-            "timeout_s": 120 + 100 * len(scenario["cycles"])}
+            "sensor_models": sensor_models, "timeout_s": 120 + 100 * len(scenario["cycles"])}
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
