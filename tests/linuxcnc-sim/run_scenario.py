@@ -318,6 +318,8 @@ def main():
     parser.add_argument("scenario", choices=sorted(SCENARIOS) + ["headless_example"])
     args = parser.parse_args()
     check_prerequisites()
+    if os.path.abspath(args.work).startswith("/tmp/"):
+        fail("--work must not be under /tmp: each run mounts its own /tmp over it")
     if args.scenario == "headless_example":
         return headless_example(args)
     scenario = SCENARIOS[args.scenario]
