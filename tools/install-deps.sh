@@ -8,7 +8,7 @@ packages=(
   antlr4 libantlr4-runtime-dev default-jre-headless
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev
   libgtest-dev libbenchmark-dev
-  linuxcnc-uspace
+  linuxcnc-uspace iproute2
   locales
 )
 
