@@ -151,6 +151,18 @@ Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string messa
   return &diagnostics_.back();
 }
 
+std::size_t Diagnostics::Remove(DiagKind kind) {
+  const auto removed = std::remove_if(diagnostics_.begin(), diagnostics_.end(),
+                                      [kind](const Diagnostic& diag) { return diag.kind == kind; });
+  const std::size_t count = static_cast<std::size_t>(diagnostics_.end() - removed);
+  for (auto it = removed; it != diagnostics_.end(); ++it) {
+    if (it->severity == Severity::Error) --error_count_;
+    if (it->severity == Severity::Warning) --warning_count_;
+  }
+  diagnostics_.erase(removed, diagnostics_.end());
+  return count;
+}
+
 std::string Diagnostics::RenderText() const {
   std::string out;
   for (const Diagnostic* sorted : InSourceOrder(diagnostics_)) {

@@ -62,6 +62,11 @@ class Diagnostics {
     if (diag != nullptr) diag->notes.emplace_back(range, std::move(text));
   }
 
+  // Takes back every diagnostic of `kind` (a command that reports the same
+  // finding its own way, e.g. simulate measuring what verify's budget
+  // predicts); returns how many there were.
+  std::size_t Remove(DiagKind kind);
+
   std::size_t error_count() const { return error_count_; }
   std::size_t warning_count() const { return warning_count_; }
   bool has_errors() const { return error_count_ > 0; }

@@ -165,6 +165,7 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
     options.exit_code = ReportIoError(loaded.error());
     return;
   }
+  if (loaded.value()) cell::CheckScanCalibration(*loaded.value(), diags);
   options.exit_code = PrintDiagnostics(diags, options);
   if (!loaded.value()) return;  // the errors were printed
   const cell::Cell& cell = *loaded.value();

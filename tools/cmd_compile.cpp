@@ -5,11 +5,13 @@
 
 #include "base/json_text.h"
 #include "backend/c/c_data.h"
+#include "backend/linuxcnc/linuxcnc_dry_run.h"
 #include "backend/linuxcnc/linuxcnc_emit.h"
 #include "backend/place/place_printer.h"
 #include "backend/reports/compile_report.h"
 #include "calibration/cell.h"
 #include "frontend/parse.h"
+#include "ir/ir_ops.h"
 #include "passes/correction/compile_state.h"
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
@@ -27,6 +29,7 @@ struct CompileOptions {
   std::string report;
   bool json = false;
   bool verify_each = false;
+  bool dry_run_probe = false;  // --target linuxcnc: also OUT/dry-run/smtcal_probe_trips.ngc
 };
 
 
@@ -37,7 +40,8 @@ ReportCounts Counts(const Diagnostics& diags) {
 // The corrected program says at its top what it is.
 void AddHeader(ir::Program& program, const cell::Cell& cell) {
   std::vector<std::string> lines = {
-      fmt::format(" Corrected by smtcal {} for cell '{}' ({}). Do not edit; compile the source again.", SMTCAL_VERSION,
+      fmt::format("{}{} for cell '{}' ({}). Do not edit; compile the source again.", ir::kCorrectedHeaderPrefix,
+                  SMTCAL_VERSION,
                   cell.name, cell.path),
       " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
       " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
@@ -61,6 +65,11 @@ std::string ProgramName(const ir::Program& program) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
+  if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
+      OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
@@ -70,6 +79,9 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   std::optional<LinuxCncOutput> linuxcnc;
   if (opt.target == "linuxcnc" && !diags.has_errors()) {
     linuxcnc = EmitLinuxCnc(compiled.program, state, opt.program_path, diags);
+    if (linuxcnc && opt.dry_run_probe) {
+      linuxcnc->dry_run.push_back({kLinuxCncDryRunFile, EmitLinuxCncDryRunProbe(*compiled.cell)});
+    }
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;  // nothing half-written
@@ -145,10 +157,21 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
                       "the file to write, the directory for --target linuxcnc ('-' for stdout: with linuxcnc, the "
                       "main program and smtcal_data.ngc for review)")
       ->required();
+  compile->add_flag("--dry-run-probe", compile_options.dry_run_probe,
+                    "with --target linuxcnc: also write OUT/dry-run/smtcal_probe_trips.ngc, the nominal trips of "
+                    "the nominal board instead of the marker scan, for rs274 only (put OUT/dry-run first on its "
+                    "subroutine path; examples/linuxcnc/README.md)");
   compile->add_option("--report", compile_options.report,
                       "also write a JSON report of every motion target (required and nominal position, correction, "
                       "region, residual, budget) and the cycle-time estimate");
-  compile->callback([&options] { RunCompile(compile_options, options); });
+  compile->callback([&options] {
+    if (compile_options.dry_run_probe && compile_options.target != "linuxcnc") {
+      fmt::print(stderr, "smtcal: error: --dry-run-probe needs --target linuxcnc\n");
+      options.exit_code = kExitUsageError;
+      return;
+    }
+    RunCompile(compile_options, options);
+  });
 
   static CompileOptions verify_options;
   CLI::App* verify = app.add_subcommand(

@@ -321,7 +321,8 @@ void AddFixtureCommand(CLI::App& app, GlobalOptions& options) {
   command->add_option("--fixture", opt.fixture, "the fixture's name in the cell (case-insensitive)")->required();
   command->add_option("--trips", opt.trips,
                       "the trip points: CSV name,x_mm,y_mm[,z_mm], one row per trip T1..Tn in the robot\n"
-                      "base frame as commanded when the sensor tripped ('-' for stdin)")
+                      "base frame as commanded when the sensor tripped ('-' for stdin); a trip without a row\n"
+                      "is missing, and a header without rows is a scan in which no trip was recorded")
       ->required();
   command->add_option("--estimator", opt.estimator,
                       "paper (Eq. 4 on the fitted lines' crossings), rigid (least squares over all trips:\n"

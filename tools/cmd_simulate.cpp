@@ -54,10 +54,18 @@ bool CheckTraces(const ir::Program& program, const CompileState& state, Diagnost
 }
 
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
+  if (OutputOverwritesInput("--svg", opt.svg, {opt.program_path, opt.cell_path, opt.truth_path})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  // verify's verdicts on accuracy are what the simulation measures: they do
+  // not stop it, the report says how many there were.
+  const std::size_t over_budget =
+      diags.Remove(DiagKind::BudgetOverTolerance) + diags.Remove(DiagKind::FixtureBudgetUnbounded);
   if (diags.has_errors()) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
@@ -78,7 +86,7 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   if (diags.has_errors()) return;
 
   SimResult result = Simulate(state, truth, opt.sim);
-  SimulateContext context{opt.program_path, &*compiled.cell, &truth};
+  SimulateContext context{opt.program_path, &*compiled.cell, &truth, over_budget};
   if (!opt.svg.empty()) {
     if (Status written = WriteFileAtomically(opt.svg, SimulateReportSvg(result, context)); !written) {
       options.exit_code = ReportIoError(written.error());

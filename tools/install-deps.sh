@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev
   libgtest-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev  # the fuzz harnesses: clang and its libFuzzer runtime (tests/fuzz/)
-  linuxcnc-uspace
+  linuxcnc-uspace iproute2
   locales
 )
 

@@ -31,6 +31,8 @@
 
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_dry_run.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "ir/constant_fold.h"
 #include "ir/ir_text.h"
 #include "ir/ir_walk.h"
@@ -281,7 +283,7 @@ class Emitter {
   std::set<std::pair<std::uint32_t, std::uint32_t>> too_long_;  // statements reported
   void Abort(std::string_view message, SourceLoc loc) {
     // The abort's own text is the message; the location is inside it.
-    Emit(fmt::format("{}(abort, smtcal: {} at {})", std::string(static_cast<std::size_t>(indent_) * 2, ' '),
+    Emit(fmt::format("{}(abort,smtcal: {} at {})", std::string(static_cast<std::size_t>(indent_) * 2, ' '),
                      Sanitize(message), Sanitize(Where(loc))),
          loc);
   }
@@ -784,7 +786,7 @@ std::string NotOurOutput(const fs::path& dir) {
   if (!fs::is_directory(dir)) return fmt::format("'{}' exists and is not a directory", dir.string());
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const fs::path& path = entry.path();
-    if (entry.is_directory() && path.filename() == "subroutines") {
+    if (entry.is_directory() && (path.filename() == "subroutines" || path.filename() == kLinuxCncDryRunFolder)) {
       for (const fs::directory_entry& sub : fs::directory_iterator(path)) {
         std::string name = sub.path().filename().string();
         if (!sub.is_regular_file() || !name.starts_with("smtcal_") || sub.path().extension() != ".ngc") {
@@ -814,6 +816,10 @@ Status WriteTree(const fs::path& dir, const LinuxCncOutput& output) {
   if (Status written = WriteText(dir / output.main_name, output.main_text); !written) return written;
   for (const EmbeddedFile& file : output.subroutines) {
     if (Status written = WriteText(dir / "subroutines" / file.name, file.text); !written) return written;
+  }
+  if (!output.dry_run.empty()) fs::create_directories(dir / kLinuxCncDryRunFolder, error);
+  for (const EmbeddedFile& file : output.dry_run) {
+    if (Status written = WriteText(dir / kLinuxCncDryRunFolder / file.name, file.text); !written) return written;
   }
   return Ok{};
 }
@@ -852,6 +858,7 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   output.main_text = std::move(*main);
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
+  output.subroutines.push_back({"smtcal_scan_abort.ngc", EmitLinuxCncScanAbort(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
             [](const EmbeddedFile& a, const EmbeddedFile& b) { return a.name < b.name; });
   return output;
@@ -860,7 +867,12 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
 std::string LinuxCncReviewText(const LinuxCncOutput& output) {
   std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, output.main_text);
   for (const EmbeddedFile& file : output.subroutines) {
-    if (file.name == "smtcal_data.ngc") text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
+    if (file.name == "smtcal_data.ngc" || file.name == "smtcal_scan_abort.ngc") {
+      text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
+    }
+  }
+  for (const EmbeddedFile& file : output.dry_run) {
+    text += fmt::format("(smtcal file: {}/{})\n{}", kLinuxCncDryRunFolder, file.name, file.text);
   }
   return text;
 }

@@ -28,6 +28,7 @@ struct LinuxCncOutput {
   std::string main_name;                  // "<program file stem>.ngc"
   std::string main_text;
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
+  std::vector<EmbeddedFile> dry_run;      // OUTDIR/dry-run/ (--dry-run-probe, linuxcnc_dry_run.h), or none
 };
 
 // Lowers the program. What the target cannot express (a cell without a
