@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/field_text.h"
+
 namespace smtcal {
 namespace {
 
@@ -30,18 +32,15 @@ std::string Location(const SourceManager& sources, const SourceRange& range) {
   return fmt::format("{}:{}:{}", file.name, range.begin.line, range.begin.column);
 }
 
-// Length of the valid UTF-8 sequence starting at text[i], or 0 if invalid.
-std::size_t Utf8SequenceLength(std::string_view text, std::size_t i) {
-  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  unsigned char lead = byte(i);
-  std::size_t length = lead < 0x80 ? 1 : (lead >> 5) == 0x6 ? 2 : (lead >> 4) == 0xE ? 3
-                                   : (lead >> 3) == 0x1E ? 4 : 0;
-  if (length == 0 || i + length > text.size()) return 0;
-  for (std::size_t k = 1; k < length; ++k) {
-    if ((byte(i + k) & 0xC0) != 0x80) return 0;
-  }
-  return length;
-}
+// A source line longer than this many bytes is quoted as a window around
+// the caret, with "..." where it is cut: a 2 MB CSV header line must not
+// make a message of 2 MB. Program lines of a few hundred bytes stay whole.
+constexpr std::size_t kSnippetMaxBytes = 320;
+constexpr std::size_t kSnippetBytesBeforeCaret = 120;
+constexpr std::string_view kEllipsis = "...";
+constexpr std::size_t kMaxMessageBytes = 1000;
+
+bool IsContinuationByte(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
 // The quoted source line and a caret line under the range. The line is made
 // safe for a terminal (control characters and invalid UTF-8 bytes become
@@ -52,21 +51,32 @@ void AppendSnippet(std::string& out, const SourceManager& sources, const SourceR
   std::string_view line = sources.File(range.begin.file).Line(range.begin.line);
   std::size_t begin = range.begin.column == 0 ? 0 : range.begin.column - 1;
   std::size_t end = begin + std::max<std::uint32_t>(range.length, 1);
-  std::string shown;
-  std::string marks;
+  // The part of the line shown: all of it, or a window that starts
+  // kSnippetBytesBeforeCaret before the caret, at a character boundary.
+  std::size_t from = 0, to = line.size();
+  if (line.size() > kSnippetMaxBytes) {
+    std::size_t caret = std::min(begin, line.size());
+    from = caret > kSnippetBytesBeforeCaret ? caret - kSnippetBytesBeforeCaret : 0;
+    while (from > 0 && IsContinuationByte(line[from])) --from;
+    to = std::min(line.size(), from + kSnippetMaxBytes);
+    while (to < line.size() && IsContinuationByte(line[to])) ++to;
+  }
+  std::string shown(from > 0 ? kEllipsis : "");
+  std::string marks(from > 0 ? kEllipsis.size() : 0, ' ');
   bool caret_placed = false;
-  for (std::size_t i = 0; i < line.size();) {
-    std::size_t length = Utf8SequenceLength(line, i);
+  for (std::size_t i = from; i < to;) {
+    std::size_t length = Utf8Length(line, i);
     unsigned char c = static_cast<unsigned char>(line[i]);
     bool printable = length > 1 || (length == 1 && (c >= 0x20 || c == '\t') && c != 0x7F);
     std::size_t step = length == 0 ? 1 : length;
     shown += printable ? std::string(line.substr(i, step)) : std::string("?");
     char mark = c == '\t' ? '\t' : ' ';
-    if (i >= begin && i < end) mark = caret_placed ? '~' : '^';
+    if (i + step > begin && i < end) mark = caret_placed ? '~' : '^';
     if (mark == '^') caret_placed = true;
     marks += mark;
     i += step;
   }
+  if (to < line.size()) shown += kEllipsis;
   if (!caret_placed) marks += '^';  // the range starts at the end of the line
   while (!marks.empty() && (marks.back() == ' ' || marks.back() == '\t')) marks.pop_back();
   out += fmt::format("  {}\n  {}\n", shown, marks);
@@ -75,13 +85,13 @@ void AppendSnippet(std::string& out, const SourceManager& sources, const SourceR
 // Diagnostics in source order (file, line, column), whatever pass found them;
 // equal locations keep the order they were reported in. Diagnostics about a
 // whole file (no line) follow that file's located ones, and the
-// too-many-errors marker stays last: both are summaries.
+// too-many-errors and too-many-warnings markers stay last: both are summaries.
 std::vector<const Diagnostic*> InSourceOrder(const std::vector<Diagnostic>& diagnostics) {
   std::vector<const Diagnostic*> sorted;
   for (const Diagnostic& diag : diagnostics) sorted.push_back(&diag);
   std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic* a, const Diagnostic* b) {
-    bool a_last = a->kind == DiagKind::TooManyErrors;
-    bool b_last = b->kind == DiagKind::TooManyErrors;
+    bool a_last = a->kind == DiagKind::TooManyErrors || a->kind == DiagKind::TooManyWarnings;
+    bool b_last = b->kind == DiagKind::TooManyErrors || b->kind == DiagKind::TooManyWarnings;
     if (a_last != b_last) return b_last;
     const SourceLoc& x = a->range.begin;
     const SourceLoc& y = b->range.begin;
@@ -110,6 +120,14 @@ std::string_view SeverityName(Severity severity) {
 
 Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
   if (limit_reached_) return nullptr;
+  // A message quotes fields of the input; a 2 MB column name must not make
+  // a 2 MB message. Cut at a character boundary.
+  if (message.size() > kMaxMessageBytes) {
+    std::size_t cut = kMaxMessageBytes;
+    while (cut > 0 && IsContinuationByte(message[cut])) --cut;
+    message.resize(cut);
+    message += kEllipsis;
+  }
   Severity severity = DiagKindSeverity(kind);
   if (severity == Severity::Error && error_count_ >= error_limit_) {
     limit_reached_ = true;
@@ -118,10 +136,31 @@ Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string messa
     ++error_count_;
     return nullptr;
   }
+  if (severity == Severity::Warning && ++warning_count_ > warning_limit_) {
+    // Counted (the summaries say how many), but no longer shown.
+    if (warning_count_ == warning_limit_ + 1) {
+      diagnostics_.push_back({DiagKind::TooManyWarnings, Severity::Warning, range,
+                              fmt::format("more than {} warnings; the others are counted but not shown",
+                                          warning_limit_),
+                              {}});
+    }
+    return nullptr;
+  }
   if (severity == Severity::Error) ++error_count_;
-  if (severity == Severity::Warning) ++warning_count_;
   diagnostics_.push_back({kind, severity, range, std::move(message), {}});
   return &diagnostics_.back();
+}
+
+std::size_t Diagnostics::Remove(DiagKind kind) {
+  const auto removed = std::remove_if(diagnostics_.begin(), diagnostics_.end(),
+                                      [kind](const Diagnostic& diag) { return diag.kind == kind; });
+  const std::size_t count = static_cast<std::size_t>(diagnostics_.end() - removed);
+  for (auto it = removed; it != diagnostics_.end(); ++it) {
+    if (it->severity == Severity::Error) --error_count_;
+    if (it->severity == Severity::Warning) --warning_count_;
+  }
+  diagnostics_.erase(removed, diagnostics_.end());
+  return count;
 }
 
 std::string Diagnostics::RenderText() const {

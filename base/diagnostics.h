@@ -46,18 +46,26 @@ struct Diagnostic {
 
 class Diagnostics {
  public:
-  explicit Diagnostics(const SourceManager& sources, std::size_t error_limit = 50)
-      : sources_(sources), error_limit_(error_limit) {}
+  // After `error_limit` errors a TooManyErrors marker ends the list; after
+  // `warning_limit` warnings a TooManyWarnings marker stands for the rest,
+  // which are counted but not kept.
+  explicit Diagnostics(const SourceManager& sources, std::size_t error_limit = 50, std::size_t warning_limit = 100)
+      : sources_(sources), error_limit_(error_limit), warning_limit_(warning_limit) {}
 
   template <typename... Args>
   Diagnostic* Report(DiagKind kind, SourceRange range, const Args&... args) {
     return Add(kind, range, fmt::vformat(DiagKindFormat(kind), fmt::make_format_args(args...)));
   }
   // Attaches a note to the diagnostic returned by Report (ignored if null:
-  // Report returns null once the error limit is reached).
+  // Report returns null once the error or warning limit is reached).
   static void AddNote(Diagnostic* diag, SourceRange range, std::string text) {
     if (diag != nullptr) diag->notes.emplace_back(range, std::move(text));
   }
+
+  // Takes back every diagnostic of `kind` (a command that reports the same
+  // finding its own way, e.g. simulate measuring what verify's budget
+  // predicts); returns how many there were.
+  std::size_t Remove(DiagKind kind);
 
   std::size_t error_count() const { return error_count_; }
   std::size_t warning_count() const { return warning_count_; }
@@ -79,6 +87,7 @@ class Diagnostics {
 
   const SourceManager& sources_;
   std::size_t error_limit_;
+  std::size_t warning_limit_;
   std::size_t error_count_ = 0;
   std::size_t warning_count_ = 0;
   bool limit_reached_ = false;

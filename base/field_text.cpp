@@ -1,6 +1,7 @@
 // Field text shared by the file readers (base/field_text.h).
 #include "base/field_text.h"
 
+#include <charconv>
 #include <cmath>
 #include <system_error>
 
@@ -61,6 +62,14 @@ std::string AsciiLowercase(std::string_view text) {
   std::string lower(text);
   for (char& c : lower) c = AsciiLower(c);
   return lower;
+}
+
+double RoundedToDecimals(double value, int decimals) {
+  if (!std::isfinite(value)) return value;
+  const std::string text = fmt::format("{:.{}f}", value, decimals);
+  double rounded = 0;
+  std::from_chars(text.data(), text.data() + text.size(), rounded);
+  return rounded == 0 ? 0.0 : rounded;
 }
 
 }  // namespace smtcal

@@ -30,4 +30,9 @@ std::optional<double> ParseNumber(std::string_view text);
 char AsciiLower(char c);
 std::string AsciiLowercase(std::string_view text);
 
+// The double nearest to `value` written with `decimals` decimals, so that a
+// JSON writer's shortest form prints exactly those digits (0.285, not
+// 0.28500000000000003); -0 becomes 0. Non-finite values pass through.
+double RoundedToDecimals(double value, int decimals);
+
 }  // namespace smtcal

@@ -1,5 +1,6 @@
 // Source files and locations. Every IR node and every diagnostic carries a
 // SourceLoc; the SourceManager owns the text so diagnostics can quote lines.
+// Outputs are written atomically (StagedOutput, WriteFileAtomically).
 #pragma once
 
 #include <cstdint>
@@ -27,13 +28,21 @@ struct SourceFile {
   std::vector<std::size_t> line_starts;  // byte offset of each line
 
   std::string_view Line(std::uint32_t line) const;  // without the newline
+  // The location of a byte offset (offsets past the end: the last byte).
+  SourceLoc LocationOf(std::uint32_t id, std::size_t offset) const;
 };
+
+// The most smtcal reads from one input file or from standard input. The
+// largest real inputs (a million-placement program or CAD list) are under
+// 100 MiB; a bound keeps `smtcal check /dev/zero` from reading forever.
+inline constexpr std::size_t kMaxInputBytes = std::size_t{256} << 20;
 
 class SourceManager {
  public:
   // Registers text under a name; returns its id (never 0).
   std::uint32_t Add(std::string name, std::string text);
-  // Reads a file ("-" is stdin) and registers it.
+  // Reads a file ("-" is stdin) and registers it. Fails on a directory and
+  // on more than kMaxInputBytes.
   Result<std::uint32_t> Load(const std::string& path);
 
   const SourceFile& File(std::uint32_t id) const;
@@ -42,8 +51,49 @@ class SourceManager {
   std::vector<std::unique_ptr<SourceFile>> files_;
 };
 
-// Writes `contents` to `path` atomically: a temporary file beside it, then a
-// rename, so a failure never leaves a half-written output. "-" is stdout.
+// An output written completely to a temporary file beside its destination,
+// not yet in place. Commit() renames it over the destination; a StagedOutput
+// destroyed before that removes the temporary. Staging several outputs
+// before committing any is how a command writes all of them or none.
+//
+// The destination: "-" is standard output (written at Commit). A symbolic
+// link is followed to the file it names, which is replaced (the link stays).
+// A directory, device, FIFO or socket is refused: replacing it by renaming
+// would be wrong, and writing into it is not atomic. An existing file keeps
+// its permission bits.
+//
+// The temporary is "<destination>.smtcal-tmp-<pid>" (the file name shortened
+// to fit the system's 255-byte limit). One left behind by a killed smtcal is
+// removed the next time smtcal writes that destination.
+class StagedOutput {
+ public:
+  // The whole contents at once.
+  static Result<StagedOutput> Stage(const std::string& path, std::string_view contents);
+  // An output written piece by piece (base/text_output.h): Append() as it is
+  // produced, then Commit(). A failed write is reported by Commit().
+  static Result<StagedOutput> Open(const std::string& path);
+  void Append(std::string_view contents);
+
+  StagedOutput(StagedOutput&& other) noexcept;
+  StagedOutput& operator=(StagedOutput&& other) noexcept;
+  StagedOutput(const StagedOutput&) = delete;
+  StagedOutput& operator=(const StagedOutput&) = delete;
+  ~StagedOutput();
+
+  Status Commit();
+
+ private:
+  StagedOutput() = default;
+  Status Close();            // the temporary's descriptor; the first write error
+  std::string path_;         // as the user gave it, for messages
+  std::string destination_;  // the file replaced (symbolic links followed); empty: stdout
+  std::string temporary_;    // empty once committed or removed
+  std::string stdout_text_;  // the contents, for stdout
+  int fd_ = -1;              // the temporary, while it is written
+  int write_error_ = 0;      // the errno of the first failed write
+};
+
+// Stage and Commit in one: a failure never leaves a half-written output.
 Status WriteFileAtomically(const std::string& path, std::string_view contents);
 
 }  // namespace smtcal

@@ -1,9 +1,9 @@
 #include "base/text_output.h"
 
-#include <unistd.h>
-
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -12,23 +12,19 @@ namespace smtcal {
 Result<std::unique_ptr<TextOutput>> TextOutput::Open(const std::string& path) {
   auto output = std::make_unique<TextOutput>();
   output->path_ = path;
-  if (path == "-") return output;
-  output->temp_ = fmt::format("{}.tmp.{}", path, ::getpid());
-  output->file_ = std::fopen(output->temp_.c_str(), "wb");
-  // Name the file the user asked for; the temporary is our business.
-  if (output->file_ == nullptr) return Error{fmt::format("cannot write '{}': {}", path, std::strerror(errno))};
+  if (path == "-") return output;  // kept whole: nothing of a failed run is printed
+  Result<StagedOutput> staged = StagedOutput::Open(path);
+  if (!staged) return staged.error();
+  output->file_.emplace(std::move(staged).value());
   return output;
 }
 
-TextOutput::~TextOutput() {
-  if (file_ != nullptr) {
-    std::fclose(file_);
-    std::remove(temp_.c_str());
-  }
-}
+// A TextOutput never committed leaves nothing: the StagedOutput removes its
+// temporary.
+TextOutput::~TextOutput() = default;
 
 void TextOutput::Flush() {
-  if (error_ == 0 && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) error_ = errno;
+  file_->Append(buffer_);
   written_ += buffer_.size();
   buffer_.clear();
 }
@@ -37,24 +33,13 @@ Status TextOutput::Commit() {
   if (path_.empty()) return Ok{};
   if (path_ == "-") {
     std::fwrite(buffer_.data(), 1, buffer_.size(), stdout);
-    if (std::fflush(stdout) != 0 || std::ferror(stdout)) return Error{"cannot write to standard output"};
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) return Error{fmt::format("cannot write to standard output: {}", std::strerror(errno))};
     return Ok{};
   }
   Flush();
-  if (std::fflush(file_) != 0 && error_ == 0) error_ = errno;
-  if (std::fclose(file_) != 0 && error_ == 0) error_ = errno;
-  file_ = nullptr;
-  if (error_ != 0) {
-    std::remove(temp_.c_str());
-    return Error{fmt::format("cannot write '{}': {}", path_, std::strerror(error_))};
-  }
-  if (std::rename(temp_.c_str(), path_.c_str()) != 0) {
-    int saved = errno;
-    std::remove(temp_.c_str());
-    return Error{fmt::format("cannot write '{}' (renaming the finished temporary '{}' failed): {}", path_, temp_,
-                             std::strerror(saved))};
-  }
-  return Ok{};
+  Status committed = file_->Commit();
+  file_.reset();
+  return committed;
 }
 
 }  // namespace smtcal

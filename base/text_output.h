@@ -1,17 +1,19 @@
 // An output text written as it is produced, still atomically: the pieces go
-// to a temporary file beside the target, and only Commit() renames it into
+// to a temporary file beside the target (a StagedOutput, base/source.h, with
+// its rules for links, devices and modes), and only Commit() renames it into
 // place, so a run that fails (or is killed) never leaves a half-written
 // file, and a large output never has to be held in memory at once. Standard
 // output ("-") and memory keep the whole text until Commit(), for the same
 // reason (nothing of a failed run is printed).
 #pragma once
 
-#include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "base/result.h"
+#include "base/source.h"
 
 namespace smtcal {
 
@@ -34,7 +36,7 @@ class TextOutput {
     Produced();
   }
   void Produced() {
-    if (file_ != nullptr && buffer_.size() >= kFlushBytes) Flush();
+    if (file_ && buffer_.size() >= kFlushBytes) Flush();
   }
 
   // Writes what is left and renames the temporary to the target (prints it,
@@ -49,12 +51,10 @@ class TextOutput {
   static constexpr std::size_t kFlushBytes = 1 << 20;
   void Flush();
 
-  std::string path_;  // the target; empty for memory
-  std::string temp_;  // the temporary beside it, while it exists
-  std::FILE* file_ = nullptr;
+  std::string path_;                  // the target; empty for memory
+  std::optional<StagedOutput> file_;  // a file's temporary, until Commit
   std::string buffer_;
   std::size_t written_ = 0;
-  int error_ = 0;  // the first errno of a failed write
 };
 
 }  // namespace smtcal

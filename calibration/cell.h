@@ -58,6 +58,21 @@ struct Robot {
   double u_accel_deg_s2 = 0;
   double pick_time_s = 0;   // vacuum on and settle at a pick
   double place_time_s = 0;  // vacuum off and release at a place
+  // The robot's accuracy where no table corrects it: the largest position
+  // error it makes there (the paper: about 0.25 mm once the gripper was
+  // mounted). Unset: not declared, and nothing that depends on it can be
+  // bounded (verify says so).
+  std::optional<double> uncalibrated_accuracy_mm;
+  SourceRange uncalibrated_accuracy_range;  // its key (the [robot] table when absent)
+  // How far the error changes by about its own size: next to a table the
+  // error stays near the table's edge value for about this distance (how far
+  // a table may be trusted beyond its edge). Shapes the virtual cell's field.
+  double uncalibrated_correlation_mm = 25;
+  // The controller latches the marker sensor once per servo period, so a
+  // trip lands up to scan_speed_mm_s * servo_period_s past the edge along
+  // its leg (LinuxCNC's servo thread: 1 ms).
+  double servo_period_s = 0.001;
+  SourceRange servo_period_range;  // its key (the [robot] table when absent)
   SourceRange range;        // the [robot] table
 };
 
@@ -135,6 +150,7 @@ struct Fixture {
   std::vector<ScanPath> scan_paths;  // at least one; every edge crossed at least twice
   double scan_z_mm = 0;          // sensor height over the markers (robot z)
   double scan_speed_mm_s = 0;    // feed along the scan paths
+  SourceRange scan_speed_range;  // its key
   double trip_window_mm = 0;     // a trip is expected within this distance of its nominal point along the leg
   int sensor_input = 0;          // digital input the sensor is wired to
   double sensor_accuracy_mm = 0; // +- where the sensor trips against the true edge

@@ -35,6 +35,11 @@ SourceRange AxisTable::Origin(std::size_t i, std::size_t j) const {
   return origin.empty() ? SourceRange() : origin[Index(i, j)];
 }
 
+std::optional<double> AxisTable::StandardErrorMm(std::size_t node) const {
+  if (node >= stddev_mm.size() || node >= count.size() || !stddev_mm[node] || count[node] <= 0) return std::nullopt;
+  return *stddev_mm[node] / std::sqrt(static_cast<double>(count[node]));
+}
+
 // ------------------------------------------------------------------ assembly
 
 namespace {

@@ -60,6 +60,9 @@ struct AxisTable {
   double At(std::size_t i, std::size_t j) const { return error_mm[Index(i, j)]; }
   // Where node (i, j) was written; an unknown range for tables built in code.
   SourceRange Origin(std::size_t i, std::size_t j) const;
+  // The standard error of a node's mean, stddev / sqrt(n), when the table
+  // states both; nullopt when it says nothing about the node's noise.
+  std::optional<double> StandardErrorMm(std::size_t node) const;
 };
 
 struct ErrorTable {

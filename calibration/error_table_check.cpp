@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "base/check.h"
+#include "calibration/table_outliers.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
@@ -127,8 +128,15 @@ void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {
     const AxisTable& t = table[axis];
     std::size_t pairs = 0;
     std::size_t fi = 0, fj = 0, si = 0, sj = 0;
+    // A node's value is "clearly of its sign" when it is farther from zero
+    // than kSignChangeMinMm and three of its standard errors: smaller values
+    // are noise around zero, where the paper's condition says nothing.
+    auto clear = [&](std::size_t i, std::size_t j) {
+      const double se = t.StandardErrorMm(t.Index(i, j)).value_or(0.0);
+      return std::abs(t.At(i, j)) > std::max(kSignChangeMinMm, 3 * se);
+    };
     auto visit = [&](std::size_t i, std::size_t j, std::size_t i2, std::size_t j2) {
-      if (!(t.At(i, j) * t.At(i2, j2) < 0)) return;
+      if (!(t.At(i, j) * t.At(i2, j2) < 0) || !clear(i, j) || !clear(i2, j2)) return;
       if (pairs++ == 0) {
         fi = i, fj = j, si = i2, sj = j2;
       }
@@ -176,6 +184,16 @@ void WarnOverHalfPitch(const ErrorTable& table, Diagnostics& diags) {
     diags.Report(DiagKind::TableErrorOverHalfPitch, t.Origin(wi, wj), AxisName(axis),
                  Signed(t.At(wi, wj)), FormatMm(t.xs[wi]), FormatMm(t.ys[wj]), FormatMm(worst_pitch),
                  more);
+  }
+}
+
+void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
+  for (const TableOutlier& outlier : FindTableOutliers(table)) {
+    const AxisTable& t = table[outlier.axis];
+    diags.Report(DiagKind::TableOutlierNode, t.Origin(outlier.i, outlier.j), AxisName(outlier.axis),
+                 Signed(outlier.value_mm), FormatMm(t.xs[outlier.i]), FormatMm(t.ys[outlier.j]),
+                 Signed(outlier.predicted_mm), fmt::format("{:.4f}", outlier.scatter_mm),
+                 outlier.likely_slip.empty() ? std::string("a typo or a bad measurement") : outlier.likely_slip);
   }
 }
 
@@ -239,6 +257,7 @@ bool ValidateErrorTable(const ErrorTable& table, Diagnostics& diags, TableWarnin
                         TableAnalysis* analysis_out) {
   TableAnalysis analysis = AnalyzeTable(table);
   std::size_t errors_before = diags.error_count();
+  ReportOutliers(table, diags);
   ReportFolds(table, analysis, diags);
   // A folding table is also steep; its fold is the message that matters.
   if (diags.error_count() == errors_before) ReportSteep(table, analysis, diags);

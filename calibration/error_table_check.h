@@ -53,8 +53,11 @@ enum class TableWarnings { kReport, kSkip };
 
 // Errors: the map folds or nearly folds (det < kMinJacobianDet) or the error
 // is too steep for the inverse solver (L > kMaxErrorSlope); each names the
-// worst cell and its slopes. Warnings (kReport): the error changes sign
-// between neighbouring nodes; an error exceeds half the grid pitch.
+// worst cell and its slopes; a node disagrees with its neighbours far beyond
+// the table's noise (calibration/table_outliers.h), named with its likely
+// slip. Warnings (kReport): the error changes sign between neighbouring nodes
+// that are both clearly off zero (kSignChangeMinMm); an error exceeds half
+// the grid pitch.
 // Returns false when an error was reported. Requires HasUsableShape.
 bool ValidateErrorTable(const ErrorTable& table, Diagnostics& diags, TableWarnings warnings,
                         TableAnalysis* analysis = nullptr);

@@ -305,6 +305,23 @@ Eigen::Vector2d DirectCalibrateInCell(const std::vector<cell::Region>& regions, 
   return DirectCalibrateThrough(MapsOf(regions), commanded, region);
 }
 
+std::vector<Eigen::Vector2d> CommandedTrips(const cell::Fixture& fixture, const std::vector<cell::Region>& regions,
+                                            const Eigen::Affine3d& fix) {
+  const std::vector<CalibrationMap> maps = MapsOf(regions);
+  std::vector<Eigen::Vector2d> commanded;
+  for (const Eigen::Vector2d& trip : NominalTrips(fixture, fix)) {
+    // A contraction (the tables' slopes are far below 1): c <- c + (t - F(c)).
+    Eigen::Vector2d c = trip;
+    for (int step = 0; step < 100; ++step) {
+      const Eigen::Vector2d miss = trip - DirectCalibrateThrough(maps, c, nullptr);
+      c += miss;
+      if (miss.norm() < 1e-13) break;
+    }
+    commanded.push_back(c);
+  }
+  return commanded;
+}
+
 const CheckResult& ScanResult::Check(ScanCheck check) const {
   for (const CheckResult& result : checks) {
     if (result.check == check) return result;
@@ -528,44 +545,6 @@ CorrectedPoint PointCorrector::Invert(const Eigen::Vector2d& required) const {
 
 CorrectedPoint PointCorrector::Correct(const Eigen::Affine3d& fix_n, const Eigen::Vector2d& fixpos0) const {
   return Invert(ToBase(fix_n, fixpos0));
-}
-
-// ------------------------------------------------------------------ sensor share
-
-SensorShare::SensorShare(const cell::Fixture& fixture) : accuracy_mm_(fixture.sensor_accuracy_mm) {
-  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
-  const Eigen::Affine3d nominal = NominalFix(fixture);
-  const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, nominal);
-  const Eigen::Matrix2d rotation = nominal.linear().topLeftCorner<2, 2>();
-  const double h = kSensorShareStepMm;
-  for (std::size_t k = 0; k < trips.size(); ++k) {
-    // The sensor's error moves the trip across its edge: along the edge's
-    // normal in the base frame (a move along the edge changes no fit).
-    const Eigen::Vector2d across =
-        rotation * EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]).normal;
-    std::vector<Eigen::Vector2d> plus = trips, minus = trips;
-    plus[k] += h * across;
-    minus[k] -= h * across;
-    std::optional<FixEstimate> a = EstimateFix(fixture, expected, plus, fixture.estimator);
-    std::optional<FixEstimate> b = EstimateFix(fixture, expected, minus, fixture.estimator);
-    if (!a || !b) return;  // defined_ stays false
-    d_linear_.push_back((a->fix.linear().topLeftCorner<2, 2>() - b->fix.linear().topLeftCorner<2, 2>()) / (2 * h));
-    d_origin_.push_back((FixOrigin(a->fix) - FixOrigin(b->fix)) / (2 * h));
-  }
-  defined_ = true;
-}
-
-double SensorShare::AtMm(const Eigen::Vector2d& point_in_fixture) const {
-  if (!defined_) return std::numeric_limits<double>::infinity();
-  double sum = 0;
-  for (std::size_t k = 0; k < d_linear_.size(); ++k) {
-    sum += (d_linear_[k] * point_in_fixture + d_origin_[k]).squaredNorm();
-  }
-  return accuracy_mm_ * std::sqrt(sum);
-}
-
-double SensorShareMm(const cell::Fixture& fixture, const Eigen::Vector2d& point_in_fixture) {
-  return SensorShare(fixture).AtMm(point_in_fixture);
 }
 
 }  // namespace smtcal

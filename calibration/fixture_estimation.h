@@ -186,28 +186,15 @@ class PointCorrector {
 Eigen::Vector2d DirectCalibrateInCell(const std::vector<cell::Region>& regions, const Eigen::Vector2d& commanded,
                                       int* region = nullptr);
 
-// --- the sensor's share of the error -------------------------------------------
+// Where the controller records each trip of a scan of a board at `fix`, for
+// a perfect sensor and a robot that moves as the cell's tables say: the
+// command c with F(c) = the trip's true position (DirectCalibrateInCell
+// inverted by fixed-point steps), in trip order. With trips inside tables
+// these, not NominalTrips, are what gives FIX = `fix` after calibration.
+std::vector<Eigen::Vector2d> CommandedTrips(const cell::Fixture& fixture, const std::vector<cell::Region>& regions,
+                                            const Eigen::Affine3d& fix);
 
-// The position error at a fixture point caused by the sensor accuracy: each
-// trip displaced by +-sensor_accuracy_mm across its edge, propagated
-// linearly through the fixture's estimator (at the nominal pose), the trips
-// independent and combined in quadrature:
-//   share(f) = accuracy * sqrt(sum_k |d(FIX f)/d e_k|^2).
-// Infinity when the fixture's nominal trips define no pose.
-double SensorShareMm(const cell::Fixture& fixture, const Eigen::Vector2d& point_in_fixture);
-
-// The same for many points: the derivatives of FIX are computed once.
-class SensorShare {
- public:
-  explicit SensorShare(const cell::Fixture& fixture);
-  double AtMm(const Eigen::Vector2d& point_in_fixture) const;
-
- private:
-  double accuracy_mm_ = 0;
-  bool defined_ = false;
-  // Per trip: d(linear part)/de and d(translation)/de.
-  std::vector<Eigen::Matrix2d> d_linear_;
-  std::vector<Eigen::Vector2d> d_origin_;
-};
+// The scan as a source of placement error (the sensor, the repeatability and
+// the latency at the trips, through the estimator): calibration/placement_budget.h.
 
 }  // namespace smtcal

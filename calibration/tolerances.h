@@ -109,10 +109,11 @@ inline constexpr double kMinRelativeDeterminant = 1e-12;
 // kRigidMaxIterations (from the similarity solution, 3 to 5 steps suffice).
 inline constexpr double kRigidStepTolRad = 1e-15;
 inline constexpr int kRigidMaxIterations = 20;
-// SensorShareMm differentiates the estimator by central differences with this
-// trip displacement: small against the 0.05 mm accuracy it scales, large
-// against rounding (relative error about 1e-8).
-inline constexpr double kSensorShareStepMm = 1e-4;
+// The error budget (calibration/placement_budget.h) differentiates the
+// estimator by central differences with this trip displacement: small against
+// the 0.05 mm accuracy it scales, large against rounding (relative error
+// about 1e-8).
+inline constexpr double kTripSensitivityStepMm = 1e-4;
 
 // --- smtcal diff (backend/diff/program_diff.cpp, docs/diff.md) --------------------
 
@@ -129,5 +130,20 @@ inline constexpr double kDiffDefaultThresholdUm = 10;
 // which gives up beyond kDiffMaxEditDistance edits in one function.
 inline constexpr double kDiffMaxAlignCells = 4e6;
 inline constexpr long kDiffMaxEditDistance = 2000;
+
+// A table's error "changes sign between neighbouring nodes" (the paper's
+// condition for linear interpolation, warned by table check) only where both
+// nodes are farther from zero than this (and three standard errors): values
+// closer to zero are noise around a zero crossing the grid resolves.
+inline constexpr double kSignChangeMinMm = 0.005;
+
+// An error table's outliers (calibration/table_outliers.h): a node whose
+// value differs from what its neighbours predict by more than this many times
+// the table's robust scatter of such differences, this many times its own
+// standard error, and this floor. The robust scatter of the example tables is
+// under 1 µm; a slipped digit in a 0.05 mm error moves it by 0.45 mm.
+inline constexpr double kOutlierScatterFactor = 10;
+inline constexpr double kOutlierNoiseFactor = 6;
+inline constexpr double kOutlierFloorMm = 0.005;
 
 }  // namespace smtcal

@@ -18,7 +18,12 @@
 namespace smtcal {
 
 enum class TruthTables { kDerived, kCell, kNone };
-enum class TruthOutside { kFade, kClamp };
+// Outside every table domain: `field` (default), a smooth random field whose
+// size is the robot's uncalibrated accuracy, into which each table's edge
+// value fades over the correlation length; `fade`, the edge value fading to
+// zero over fade_mm (a robot accurate far from its tables: kinder than any
+// cell file says, kept for comparison); `clamp`, the edge value everywhere.
+enum class TruthOutside { kField, kFade, kClamp };
 enum class ShiftDistribution { kExponential, kNormal, kUniform, kFixed };
 
 // A region's true table given in the truth file.
@@ -49,8 +54,12 @@ struct TruthSpec {
   std::string path;  // the truth file; empty: defaults
   TruthTables tables = TruthTables::kDerived;
   double perturbation_scale = 1;  // derived: multiplies each node's standard error
-  TruthOutside outside = TruthOutside::kFade;
+  TruthOutside outside = TruthOutside::kField;
   double fade_mm = 10;
+  // The field's size and correlation length; default: the cell's robot keys
+  // (uncalibrated_accuracy_mm, uncalibrated_correlation_mm).
+  std::optional<double> uncalibrated_accuracy_mm;
+  std::optional<double> uncalibrated_correlation_mm;
   // The affine part, applied everywhere.
   Eigen::Vector2d offset_mm = Eigen::Vector2d::Zero();
   double rotation_deg = 0;
@@ -61,8 +70,10 @@ struct TruthSpec {
   // Defaults: the fixture's sensor_accuracy_mm and the robot's repeatability_mm.
   std::optional<double> sensor_accuracy_mm;
   std::optional<double> repeatability_mm;
-  // false: no sensor error, no repeatability noise (and no table perturbation
-  // for `derived`): F_true and the board pose alone decide.
+  // Default: the cell's robot.servo_period_s (the trips' latch latency).
+  std::optional<double> servo_period_s;
+  // false: no sensor error, no repeatability noise, no trip latency (and no
+  // table perturbation for `derived`): F_true and the board pose alone decide.
   bool noise = true;
 };
 

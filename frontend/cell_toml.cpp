@@ -27,6 +27,7 @@
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
+#include "calibration/placement_budget.h"
 #include "calibration/tolerances.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
@@ -512,6 +513,13 @@ void Loader::ReadRobot(const toml::table& table, Robot& robot) {
   robot.u_accel_deg_s2 = PositiveNumber(keys, "u_accel_deg_s2", "deg/s^2").value_or(0);
   robot.pick_time_s = NonNegativeNumber(keys, "pick_time_s", "s").value_or(0);
   robot.place_time_s = NonNegativeNumber(keys, "place_time_s", "s").value_or(0);
+  robot.uncalibrated_accuracy_range = keys.KeyRange("uncalibrated_accuracy_mm");
+  robot.uncalibrated_accuracy_mm = PositiveNumber(keys, "uncalibrated_accuracy_mm", "mm", Need::kOptional);
+  if (auto length = PositiveNumber(keys, "uncalibrated_correlation_mm", "mm", Need::kOptional)) {
+    robot.uncalibrated_correlation_mm = *length;
+  }
+  robot.servo_period_range = keys.KeyRange("servo_period_s");
+  if (auto period = PositiveNumber(keys, "servo_period_s", "s", Need::kOptional)) robot.servo_period_s = *period;
   keys.Finish();
   robot_ = robot;
   robot_ok_ = diags_.error_count() == errors_before;
@@ -900,6 +908,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   const bool paths_ok = ReadScanPaths(keys, fixture);
   std::optional<Located<double>> scan_z = Number(keys, "scan_z_mm", Need::kRequired, "mm");
   if (scan_z) fixture.scan_z_mm = scan_z->value;
+  fixture.scan_speed_range = keys.KeyRange("scan_speed_mm_s");
   fixture.scan_speed_mm_s = PositiveNumber(keys, "scan_speed_mm_s", "mm/s").value_or(0);
   std::optional<double> window = PositiveNumber(keys, "trip_window_mm", "mm");
   fixture.trip_window_mm = window.value_or(0);
@@ -1119,6 +1128,37 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
     return std::optional<Cell>();
   }
   return loader.Load(root, path);
+}
+
+// What a clean cell can still get wrong about its scan: trips no table
+// calibrates, and a probe latch late by more than the line-residual check
+// can take (docs/cell.md, "Trips and their errors").
+static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostics& diags) {
+  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
+  const std::vector<int> regions = TripRegions(fixture, cell.regions);
+  const std::vector<TripWindow> windows = TripWindows(fixture);
+  const std::string accuracy =
+      cell.robot.uncalibrated_accuracy_mm
+          ? fmt::format("up to robot.uncalibrated_accuracy_mm = {} mm", Num(*cell.robot.uncalibrated_accuracy_mm))
+          : std::string("not declared: robot.uncalibrated_accuracy_mm");
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    if (regions[k] >= 0) continue;
+    const ScanPath& path = fixture.scan_paths[expected[k].path];
+    diags.Report(DiagKind::CellTripUncalibrated, path.range, TripName(k), Printable(fixture.name),
+                  fixture.edges[static_cast<std::size_t>(expected[k].edge)].name, Printable(path.name),
+                  fmt::format("{:.3f}", windows[k].nominal.x()), fmt::format("{:.3f}", windows[k].nominal.y()),
+                  Num(fixture.trip_window_mm), accuracy);
+  }
+  const double late_mm = fixture.scan_speed_mm_s * cell.robot.servo_period_s;
+  if (late_mm > 0.25 * fixture.max_line_residual_mm) {
+    diags.Report(DiagKind::CellTripLatency, fixture.scan_speed_range, Printable(fixture.name),
+                  Num(fixture.scan_speed_mm_s), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
+                  Num(fixture.max_line_residual_mm));
+  }
+}
+
+void CheckScanCalibration(const Cell& cell, Diagnostics& diags) {
+  for (const Fixture& fixture : cell.fixtures) CheckScanErrors(fixture, cell, diags);
 }
 
 }  // namespace smtcal::cell

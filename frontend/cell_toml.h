@@ -21,4 +21,11 @@ namespace smtcal::cell {
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags);
 
 
+// Warnings on a loaded cell's marker scans (`smtcal cell check`): every trip
+// whose window lies outside every region's table (CellTripUncalibrated: the
+// robot's own error there moves every placement on the board), and a probe
+// latch later than a quarter of the fixture's max_line_residual_mm
+// (CellTripLatency). verify covers both in its budgets.
+void CheckScanCalibration(const Cell& cell, Diagnostics& diags);
+
 }  // namespace smtcal::cell

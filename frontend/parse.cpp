@@ -34,6 +34,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <new>
 #include <span>
 #include <string>
 #include <string_view>
@@ -822,6 +823,8 @@ class SyntaxErrorListener : public antlr4::BaseErrorListener {
       } else {
         expected = parser->getExpectedTokens();
       }
+    } catch (const std::bad_alloc&) {
+      throw;
     } catch (const std::exception&) {
       deep = true;  // no expected set; fall back to a plain message
     }

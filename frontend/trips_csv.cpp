@@ -149,11 +149,8 @@ std::optional<std::vector<TripRow>> ReadTrips(std::uint32_t file, std::size_t ex
   std::optional<Header> header = ReadHeader(records.front(), diags);
   if (!header) return std::nullopt;
   const std::size_t field_count = records.front().fields.size();
-  if (records.size() == 1) {
-    diags.Report(DiagKind::CsvNoRows, SourceRange(SourceLoc{file, 0, 0}), Printable(name), kWhat, kHeaderExample,
-                 "trip");
-    return std::nullopt;
-  }
+  // A header and no rows: a scan in which the sensor never tripped (the
+  // runtime's missing_trip), not a broken file.
 
   std::vector<TripRow> trips;
   std::vector<std::uint32_t> line_of(expected_trips, 0);  // where each trip was given

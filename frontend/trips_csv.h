@@ -9,7 +9,9 @@
 // order, z_mm optional. Names are T1..Tn for the n trips the fixture's scan
 // paths make (case-insensitive), each at most once, rows in any order. A
 // trip that is not in the file is a trip the sensor did not make: the scan's
-// missing_trip check reports it, not the reader.
+// missing_trip check reports it, not the reader. A header without rows is a
+// scan in which no trip was recorded (every trip missing); a file without
+// even the header is refused.
 #pragma once
 
 #include <cstddef>

@@ -49,8 +49,12 @@ class Reader {
       spec.sensor_accuracy_mm = Number(*sensor, "accuracy_mm", 0, 5, "mm");
     }
     if (const toml::table* robot = Table(root, "robot")) {
-      CheckKeys(*robot, "[robot]", {"repeatability_mm"});
+      CheckKeys(*robot, "[robot]",
+                {"repeatability_mm", "uncalibrated_accuracy_mm", "uncalibrated_correlation_mm", "servo_period_s"});
       spec.repeatability_mm = Number(*robot, "repeatability_mm", 0, 5, "mm");
+      spec.uncalibrated_accuracy_mm = Number(*robot, "uncalibrated_accuracy_mm", 0, 10, "mm");
+      spec.uncalibrated_correlation_mm = Number(*robot, "uncalibrated_correlation_mm", 0.1, 1e4, "mm");
+      spec.servo_period_s = Number(*robot, "servo_period_s", 0, 1, "s");
     }
     for (const toml::table* region : Tables(root, "region")) ReadRegion(*region, spec);
     if (diags_.error_count() != errors_before) return std::nullopt;
@@ -66,7 +70,7 @@ class Reader {
       spec.tables = static_cast<TruthTables>(*tables);
     }
     spec.perturbation_scale = Number(table, "perturbation_scale", 0, 100, "").value_or(spec.perturbation_scale);
-    if (std::optional<int> outside = Choice(table, "outside", {"fade", "clamp"})) {
+    if (std::optional<int> outside = Choice(table, "outside", {"field", "fade", "clamp"})) {
       spec.outside = static_cast<TruthOutside>(*outside);
     }
     spec.fade_mm = Number(table, "fade_mm", 0, 1000, "mm").value_or(spec.fade_mm);

@@ -96,4 +96,13 @@ Precedence BinaryOpPrecedence(BinaryOp op) {
   return kPrimaryPrecedence;
 }
 
+const Stmt* CorrectedHeader(const Program& program) {
+  for (const StmtPtr& stmt : program.items) {
+    const auto* comment = std::get_if<Comment>(&stmt->node);
+    if (comment == nullptr) return nullptr;
+    if (comment->text.starts_with(kCorrectedHeaderPrefix)) return stmt.get();
+  }
+  return nullptr;
+}
+
 }  // namespace smtcal::ir

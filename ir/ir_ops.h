@@ -23,6 +23,13 @@ std::string_view MotionSpelling(MotionKind kind);
 // "Pick", "Place".
 std::string_view PickPlaceSpelling(PickPlaceKind kind);
 
+// `smtcal compile --target place` output opens with comments, the first of
+// them starting with this: what the program is, so it is never compiled twice.
+inline constexpr std::string_view kCorrectedHeaderPrefix = " Corrected by smtcal ";
+// The statement holding that comment among the program's leading comments,
+// or null: the program is not smtcal output.
+const Stmt* CorrectedHeader(const Program& program);
+
 // Binding strength, from the grammar's expr rule (ANTLR gives the earlier
 // alternative the higher precedence); higher binds tighter. All binary
 // operators are left-associative. A unary operator's operand is a primary or

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 
 #include "calibration/fixture_geometry.h"
 #include "simulation/sim_random.h"
@@ -17,15 +18,15 @@ bool SameName(std::string_view a, std::string_view b) {
          });
 }
 
-// Every node moved by a normal draw of its mean's standard error; nodes
-// without stddev or count stay (nothing says how far off they are).
-ErrorTable Perturbed(ErrorTable table, double scale, SimRandom& random) {
+// Every node moved by a normal draw of its mean's standard error; a node
+// without stddev and count counts as one measurement with the robot's
+// repeatability as its spread (calibration/placement_budget.h does the same).
+ErrorTable Perturbed(ErrorTable table, double scale, double repeatability_mm, SimRandom& random) {
   for (TableAxis axis : kTableAxes) {
     AxisTable& t = table[axis];
     for (std::size_t k = 0; k < t.error_mm.size(); ++k) {
       const double draw = random.Normal();
-      if (k >= t.stddev_mm.size() || k >= t.count.size() || !t.stddev_mm[k] || t.count[k] <= 0) continue;
-      t.error_mm[k] += scale * draw * *t.stddev_mm[k] / std::sqrt(static_cast<double>(t.count[k]));
+      t.error_mm[k] += scale * draw * t.StandardErrorMm(k).value_or(repeatability_mm);
     }
   }
   return table;
@@ -50,7 +51,8 @@ TrueField::TrueField(const cell::Cell& cell, const TruthSpec& spec, std::uint64_
     if (given != nullptr) {
       maps_.emplace_back(given->table);
     } else if (spec.tables == TruthTables::kDerived && spec.noise) {
-      maps_.emplace_back(Perturbed(region.table, spec.perturbation_scale, random));
+      maps_.emplace_back(Perturbed(region.table, spec.perturbation_scale,
+                                   spec.repeatability_mm.value_or(cell.robot.repeatability_mm), random));
     } else if (spec.tables != TruthTables::kNone) {
       maps_.emplace_back(region.table);
     }
@@ -62,6 +64,44 @@ TrueField::TrueField(const cell::Cell& cell, const TruthSpec& spec, std::uint64_
   linear_minus_identity_ = scale * rotation - Eigen::Matrix2d::Identity();
   about_ = spec.about_mm;
   offset_ = spec.offset_mm;
+
+  // The uncalibrated field: drawn after the tables, from the same stream.
+  const std::optional<double> declared =
+      spec.uncalibrated_accuracy_mm ? spec.uncalibrated_accuracy_mm : cell.robot.uncalibrated_accuracy_mm;
+  accuracy_mm_ = declared.value_or(kAssumedUncalibratedAccuracyMm);
+  accuracy_assumed_ = !declared;
+  correlation_mm_ = spec.uncalibrated_correlation_mm.value_or(cell.robot.uncalibrated_correlation_mm);
+  constexpr int kWavesPerAxis = 6;
+  for (std::vector<Wave>& axis : waves_) {
+    for (int m = 0; m < kWavesPerAxis; ++m) {
+      const double wavelength = correlation_mm_ * random.Uniform(3, 6);
+      const double direction = random.Uniform(0, 2 * std::numbers::pi);
+      Wave wave;
+      wave.k = (2 * std::numbers::pi / wavelength) * Eigen::Vector2d(std::cos(direction), std::sin(direction));
+      wave.phase = random.Uniform(0, 2 * std::numbers::pi);
+      wave.weight = random.Uniform(0.5, 1);
+      axis.push_back(wave);
+    }
+  }
+  // Scaled so that its largest magnitude over the robot's reach (on a grid of
+  // L / 8) is A: the field reaches the declared size, and no more.
+  field_scale_ = 1;
+  const cell::Interval& xs = cell.robot.limits[0];
+  const cell::Interval& ys = cell.robot.limits[1];
+  const double step = correlation_mm_ / 8;
+  double largest = 0;
+  for (double x = xs.lo; x <= xs.hi + 1e-9; x += step) {
+    for (double y = ys.lo; y <= ys.hi + 1e-9; y += step) largest = std::max(largest, Uncalibrated({x, y}).norm());
+  }
+  field_scale_ = largest > 0 ? accuracy_mm_ / largest : 0.0;
+}
+
+Eigen::Vector2d TrueField::Uncalibrated(const Eigen::Vector2d& n) const {
+  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  for (int a = 0; a < 2; ++a) {
+    for (const Wave& wave : waves_[static_cast<std::size_t>(a)]) g[a] += wave.weight * std::cos(wave.k.dot(n) + wave.phase);
+  }
+  return field_scale_ * g;
 }
 
 Eigen::Vector2d TrueField::TableError(const Eigen::Vector2d& n) const {
@@ -75,10 +115,20 @@ Eigen::Vector2d TrueField::TableError(const Eigen::Vector2d& n) const {
       nearest_distance = distance;
     }
   }
-  if (nearest == nullptr) return Eigen::Vector2d::Zero();
-  if (outside_ == TruthOutside::kClamp) return nearest->Delta(n);
-  const double weight = fade_mm_ > 0 ? std::max(0.0, 1 - nearest_distance / fade_mm_) : 0.0;
-  return weight * nearest->Delta(n);
+  switch (outside_) {
+    case TruthOutside::kField: {
+      if (nearest == nullptr) return Uncalibrated(n);
+      const double weight = std::max(0.0, 1 - nearest_distance / correlation_mm_);
+      return weight * nearest->Delta(n) + (1 - weight) * Uncalibrated(n);
+    }
+    case TruthOutside::kClamp: return nearest != nullptr ? nearest->Delta(n) : Eigen::Vector2d::Zero();
+    case TruthOutside::kFade: {
+      if (nearest == nullptr) return Eigen::Vector2d::Zero();
+      const double weight = fade_mm_ > 0 ? std::max(0.0, 1 - nearest_distance / fade_mm_) : 0.0;
+      return weight * nearest->Delta(n);
+    }
+  }
+  return Eigen::Vector2d::Zero();
 }
 
 Eigen::Vector2d TrueField::Actual(const Eigen::Vector2d& commanded) const {

@@ -9,10 +9,21 @@
 // Delta_true per region: the cell's table with every node moved by a normal
 // draw of its mean's standard error stddev / sqrt(n) (`derived`), the cell's
 // table as it is (`cell`), a true table file, or nothing (`none`), bilinear
-// between the nodes. Outside every table domain: the nearest domain's edge
-// value fading linearly to zero within fade_mm (`fade`), or kept (`clamp`).
+// between the nodes (a node that states no stddev and count moves by a draw
+// of the robot's repeatability, as the budget assumes). Outside every table
+// domain (TruthOutside): by default a smooth random field G whose largest
+// magnitude over the robot's reach is the robot's uncalibrated accuracy A,
+// with the nearest table's edge value fading into it linearly over the
+// correlation length L:
+//
+//   Delta_true(n) = w E(n) + (1 - w) G(n),  w = max(0, 1 - d(n) / L),
+//
+// E the nearest domain's edge value, d the distance to that domain. G is a
+// sum of plane waves per axis with wavelengths 3L..6L, random directions and
+// phases, drawn once per run. `fade` and `clamp` are the older choices.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -26,6 +37,11 @@
 
 namespace smtcal {
 
+// The field's size when neither the cell (robot.uncalibrated_accuracy_mm) nor
+// the truth file declares it: the paper's robot with its gripper. The
+// report says it was assumed.
+inline constexpr double kAssumedUncalibratedAccuracyMm = 0.25;
+
 // F_true for one run (the perturbation is drawn once, from `seed`).
 class TrueField {
  public:
@@ -34,12 +50,29 @@ class TrueField {
   // Where the robot really goes for the command n (without repeatability).
   Eigen::Vector2d Actual(const Eigen::Vector2d& commanded) const;
 
+  // The field's size outside the tables (mm), and whether it was assumed
+  // (kAssumedUncalibratedAccuracyMm) because neither the cell nor the truth
+  // declares it.
+  double uncalibrated_accuracy_mm() const { return accuracy_mm_; }
+  bool accuracy_assumed() const { return accuracy_assumed_; }
+
  private:
+  struct Wave {
+    Eigen::Vector2d k = Eigen::Vector2d::Zero();  // rad/mm
+    double phase = 0;
+    double weight = 0;
+  };
   Eigen::Vector2d TableError(const Eigen::Vector2d& n) const;
+  Eigen::Vector2d Uncalibrated(const Eigen::Vector2d& n) const;  // G(n)
 
   std::vector<CalibrationMap> maps_;
   TruthOutside outside_;
   double fade_mm_;
+  double accuracy_mm_ = 0;
+  bool accuracy_assumed_ = false;
+  double correlation_mm_ = 25;
+  std::array<std::vector<Wave>, 2> waves_;  // per axis
+  double field_scale_ = 0;                  // sum of waves -> mm, so that max |G| = A
   Eigen::Matrix2d linear_minus_identity_ = Eigen::Matrix2d::Zero();
   Eigen::Vector2d about_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d offset_ = Eigen::Vector2d::Zero();

@@ -74,6 +74,7 @@ struct PlacementPlan {
   Eigen::Vector2d taught_command = Eigen::Vector2d::Zero();  // ROBOT_0 (+ offset): replayed as taught
   Eigen::Vector2d mean_shift = Eigen::Vector2d::Zero();      // the region's table means
   double tolerance_mm = 0;
+  int region = -1;  // index into the cell's regions: where the process figures go
 };
 
 struct CyclePlan {
@@ -125,10 +126,12 @@ Eigen::Affine3d DrawBoard(const cell::Fixture& fixture, const BoardPoseModel& mo
 // true edge segment (a, b) moved `sensor_mm` along its normal, with the robot
 // `robot_mm` off its path: the commanded point then, or nullopt when the real
 // path does not cross the visible edge.
+// `late_mm`: how far past the crossing the controller latched the trip,
+// along the leg.
 std::optional<Eigen::Vector2d> SimulateTrip(const TrueField& field, const Eigen::Vector2d& from,
                                             const Eigen::Vector2d& to, const Eigen::Vector2d& a,
                                             const Eigen::Vector2d& b, double sensor_mm,
-                                            const Eigen::Vector2d& robot_mm) {
+                                            const Eigen::Vector2d& robot_mm, double late_mm) {
   const Eigen::Vector2d along = b - a;
   const Eigen::Vector2d normal = Eigen::Vector2d(-along.y(), along.x()).normalized();
   const double offset = normal.dot(a) + sensor_mm;
@@ -159,7 +162,7 @@ std::optional<Eigen::Vector2d> SimulateTrip(const TrueField& field, const Eigen:
       const double t = 0.5 * (lo + hi);
       const double s = (real(t) - a).dot(along) / along.squaredNorm();
       if (s < 0 || s > 1) return std::nullopt;  // past the end of the visible edge
-      return from + t * (to - from);
+      return from + t * (to - from) + late_mm * (to - from).normalized();
     }
     t0 = t1;
     g0 = g1;
@@ -178,9 +181,12 @@ class Simulator {
         field_(cell_, truth, random_.Split()),
         corrector_(cell_.regions) {
     repeatability_mm_ = truth.noise ? truth.repeatability_mm.value_or(cell_.robot.repeatability_mm) : 0.0;
+    servo_period_s_ = truth.noise ? truth.servo_period_s.value_or(cell_.robot.servo_period_s) : 0.0;
     PlanCycles();
     PaperTeachPoses();
   }
+
+  const TrueField& field() const { return field_; }
 
   SimResult Run() {
     SimResult result;
@@ -191,6 +197,7 @@ class Simulator {
       ModeResult m;
       m.mode = mode;
       m.scan_share = UsesPeriphery(mode) && total_s_ > 0 ? scan_s_ / total_s_ : 0.0;
+      m.by_region.resize(cell_.regions.size());
       result.modes.push_back(m);
     }
     long planned = 0;
@@ -247,6 +254,9 @@ class Simulator {
     p.true_point = p.in_frame;
     p.mean_shift = MeanShift(cell_.RegionAt(Xy(target.required)));
     p.tolerance_mm = target.region != nullptr ? target.region->tolerance_mm : 0.1;
+    for (std::size_t r = 0; r < cell_.regions.size(); ++r) {
+      if (&cell_.regions[r] == target.region) p.region = static_cast<int>(r);
+    }
     min_tolerance_mm_ = min_tolerance_mm_ == 0 ? p.tolerance_mm : std::min(min_tolerance_mm_, p.tolerance_mm);
     if (p.fixture >= 0 && target.taught_decl != nullptr) {
       const FixtureBinding& binding = state_.fixtures[p.fixture];
@@ -401,6 +411,8 @@ class Simulator {
         out.within += within ? 1 : 0;
         if (!within && injected) ++out.misplaced_injected;
         out.errors_um.push_back(error_mm * 1000);
+        out.overall.Add(error, p.tolerance_mm);
+        if (p.region >= 0) out.by_region[static_cast<std::size_t>(p.region)].Add(error, p.tolerance_mm);
         const long slot = placement_slot_ + static_cast<long>(j);
         if (slot % scatter_stride_ == 0 && out.scatter_um.size() < options_.scatter_points) {
           out.scatter_um.push_back(error * 1000);
@@ -414,15 +426,17 @@ class Simulator {
   std::vector<std::optional<Eigen::Vector2d>> Scan(const cell::Fixture& fixture, const Eigen::Affine3d& board) {
     const Eigen::Affine3d nominal = NominalFix(fixture);
     const double accuracy = truth_.noise ? truth_.sensor_accuracy_mm.value_or(fixture.sensor_accuracy_mm) : 0.0;
+    const double latency_mm = fixture.scan_speed_mm_s * servo_period_s_;
     const std::vector<ExpectedTrip>& expected = ExpectedFor(fixture);
     std::vector<std::optional<Eigen::Vector2d>> trips;
     for (const ExpectedTrip& e : expected) {
       const Eigen::Vector2d robot = RobotNoise();
       const double sensor = accuracy * random_.Uniform(-1, 1);
+      const double late = latency_mm * random_.Uniform01();
       const auto& points = fixture.scan_paths[e.path].points;
       const cell::MarkerEdge& edge = fixture.edges[static_cast<std::size_t>(e.edge)];
       trips.push_back(SimulateTrip(field_, ToBase(nominal, points[e.leg]), ToBase(nominal, points[e.leg + 1]),
-                                   ToBase(board, edge.from), ToBase(board, edge.to), sensor, robot));
+                                   ToBase(board, edge.from), ToBase(board, edge.to), sensor, robot, late));
     }
     return trips;
   }
@@ -446,6 +460,7 @@ class Simulator {
   TrueField field_;
   PointCorrector corrector_;
   double repeatability_mm_ = 0;
+  double servo_period_s_ = 0;
   std::vector<CyclePlan> plans_;
   std::vector<std::optional<Eigen::Affine3d>> paper_fix0_;
   std::vector<std::vector<std::optional<Eigen::Affine3d>>> previous_;  // [mode][fixture]
@@ -463,6 +478,9 @@ SimResult Simulate(const CompileState& state, const TruthSpec& truth, const SimO
   SMTCAL_CHECK(state.cell != nullptr, "Simulate needs a compiled program");
   Simulator simulator(state, truth, options);
   SimResult result = simulator.Run();
+  result.uncalibrated_accuracy_mm = simulator.field().uncalibrated_accuracy_mm();
+  result.accuracy_assumed = simulator.field().accuracy_assumed();
+  for (const cell::Region& region : state.cell->regions) result.regions.push_back(region.name);
   const cell::Fixture* first = state.fixtures.empty() ? nullptr : state.fixtures.front().cell_fixture;
   result.fixture_estimator =
       std::string(cell::EstimatorName(first != nullptr && first->estimator != cell::Estimator::kPaper

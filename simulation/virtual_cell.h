@@ -7,7 +7,8 @@
 //   board: a true pose FIX_true drawn from the truth's distribution
 //   scan:  the commanded V legs at the nominal pose; the robot really moves
 //          along F_true(leg) + repeatability; a trip where that path crosses
-//          the true marker edge, +- the sensor's accuracy; none if it does not
+//          the true marker edge, +- the sensor's accuracy, latched up to one
+//          servo period late (a uniform draw); none if it does not cross
 //   modes: each turns the same trips (periphery modes) and the compiled
 //          targets into commands; a failed scan check stops the cycle
 //   place: the robot lands at F_true(command) + repeatability; the error is
@@ -25,6 +26,7 @@
 
 #include <Eigen/Core>
 
+#include "calibration/capability.h"
 #include "passes/correction/compile_state.h"
 #include "simulation/true_field.h"
 
@@ -68,6 +70,10 @@ struct ModeResult {
   std::vector<double> errors_um;             // every placed part's error, in placing order
   std::vector<Eigen::Vector2d> scatter_um;   // error vectors of every k-th planned placement (at most scatter_points)
   double scan_share = 0;      // the scan's share of the cycle time (0 without periphery)
+  // Process figures of the placed parts: per region of the cell (in cell
+  // order; regions nothing was placed in stay empty) and overall.
+  std::vector<SampleCapability> by_region;
+  SampleCapability overall;
 };
 
 struct SimResult {
@@ -79,6 +85,9 @@ struct SimResult {
   int unknown_targets = 0;       // placements depending on run-time values: not simulated
   double tolerance_mm = 0;       // the smallest tolerance of a placement's region
   std::string fixture_estimator; // the improved mode's estimator
+  double uncalibrated_accuracy_mm = 0;  // the true field's size outside the tables
+  bool accuracy_assumed = false;        // not declared: kAssumedUncalibratedAccuracyMm
+  std::vector<std::string> regions;     // the cell's region names, for by_region
   std::vector<ModeResult> modes; // in kSimModes order
 };
 

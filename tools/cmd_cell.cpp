@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "base/json_text.h"
 #include "calibration/fixture_geometry.h"
 #include "frontend/cell_toml.h"
 #include "tools/commands.h"
@@ -153,7 +154,7 @@ std::string SummaryJson(const cell::Cell& cell) {
     entry["value"] = feeder.value;
     out["feeders"].push_back(entry);
   }
-  return out.dump(2) + "\n";
+  return JsonText(out);
 }
 
 void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
@@ -164,6 +165,7 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
     options.exit_code = ReportIoError(loaded.error());
     return;
   }
+  if (loaded.value()) cell::CheckScanCalibration(*loaded.value(), diags);
   options.exit_code = PrintDiagnostics(diags, options);
   if (!loaded.value()) return;  // the errors were printed
   const cell::Cell& cell = *loaded.value();

@@ -3,12 +3,15 @@
 // program, verify only reports.
 #include <fmt/core.h>
 
+#include "base/json_text.h"
 #include "backend/c/c_data.h"
+#include "backend/linuxcnc/linuxcnc_dry_run.h"
 #include "backend/linuxcnc/linuxcnc_emit.h"
 #include "backend/place/place_printer.h"
 #include "backend/reports/compile_report.h"
 #include "calibration/cell.h"
 #include "frontend/parse.h"
+#include "ir/ir_ops.h"
 #include "passes/correction/compile_state.h"
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
@@ -26,6 +29,7 @@ struct CompileOptions {
   std::string report;
   bool json = false;
   bool verify_each = false;
+  bool dry_run_probe = false;  // --target linuxcnc: also OUT/dry-run/smtcal_probe_trips.ngc
 };
 
 
@@ -36,7 +40,8 @@ ReportCounts Counts(const Diagnostics& diags) {
 // The corrected program says at its top what it is.
 void AddHeader(ir::Program& program, const cell::Cell& cell) {
   std::vector<std::string> lines = {
-      fmt::format(" Corrected by smtcal {} for cell '{}' ({}). Do not edit; compile the source again.", SMTCAL_VERSION,
+      fmt::format("{}{} for cell '{}' ({}). Do not edit; compile the source again.", ir::kCorrectedHeaderPrefix,
+                  SMTCAL_VERSION,
                   cell.name, cell.path),
       " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
       " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
@@ -52,17 +57,6 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
                        std::make_move_iterator(header.end()));
 }
 
-std::vector<CRuntimePoint> FixturePoints(const CompileState& state) {
-  std::vector<CRuntimePoint> points;
-  for (const Target& target : state.targets) {
-    if (target.kind != CorrectionKind::kFixture || !target.known) continue;
-    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].cell_fixture->name,
-                                   Eigen::Vector2d(target.in_frame[0], target.in_frame[1]), target.in_frame[2],
-                                   target.in_frame[3], target.stmt->loc});
-  }
-  return points;
-}
-
 std::string ProgramName(const ir::Program& program) {
   for (const ir::StmtPtr& item : program.items) {
     if (const auto* decl = std::get_if<ir::ProgramDecl>(&item->node)) return decl->name;
@@ -71,6 +65,11 @@ std::string ProgramName(const ir::Program& program) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
+  if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
+      OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
@@ -96,6 +95,9 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       }
     }
     linuxcnc = EmitLinuxCnc(compiled.program, state, opt.program_path, *main, diags);
+    if (linuxcnc && opt.dry_run_probe) {
+      linuxcnc->dry_run.push_back({kLinuxCncDryRunFile, EmitLinuxCncDryRunProbe(*compiled.cell)});
+    }
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;  // nothing half-written
@@ -108,22 +110,28 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       options.exit_code = kExitInputError;
       return;
     }
-    text = EmitCRuntimeData(*compiled.cell, FixturePoints(state), ProgramName(compiled.program));
+    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ProgramName(compiled.program));
   } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
   }
+  // The report and the program are written together or not at all: the
+  // report waits, complete, beside its file until the program is written.
+  std::optional<StagedOutput> report;
   if (!opt.report.empty()) {
-    std::string report = CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n";
-    if (Status written = WriteFileAtomically(opt.report, report); !written) {
-      options.exit_code = ReportIoError(written.error());
+    Result<StagedOutput> staged =
+        StagedOutput::Stage(opt.report, JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags))));
+    if (!staged) {
+      options.exit_code = ReportIoError(staged.error());
       return;
     }
+    report.emplace(std::move(staged).value());
   }
   Status written = opt.target == "c"       ? WriteFileAtomically(opt.output, text)
                    : opt.target == "place" ? WritePlace(opt.output, compiled.program)
                    : !opened               ? opened
                    : directory             ? directory->Commit(*linuxcnc)
                                            : WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc, review.text()));
+  if (written && report) written = report->Commit();
   if (!written) options.exit_code = ReportIoError(written.error());
 }
 
@@ -134,9 +142,9 @@ void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
   if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
   options.exit_code = PrintDiagnostics(diags, options);
   const CompileState& state = *compiled.program.compile;
-  std::string text = opt.json ? CompileReportJson(compiled.program, state, sources, Counts(diags)).dump(2) + "\n"
+  std::string text = opt.json ? JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags)))
                               : VerifySummaryText(compiled.program, state, sources, Counts(diags));
-  fmt::print("{}", text);
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
 }
 
 void AddCommonOptions(CLI::App& command, CompileOptions& opt) {
@@ -166,10 +174,21 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
                       "the file to write, the directory for --target linuxcnc ('-' for stdout: with linuxcnc, the "
                       "main program and smtcal_data.ngc for review)")
       ->required();
+  compile->add_flag("--dry-run-probe", compile_options.dry_run_probe,
+                    "with --target linuxcnc: also write OUT/dry-run/smtcal_probe_trips.ngc, the nominal trips of "
+                    "the nominal board instead of the marker scan, for rs274 only (put OUT/dry-run first on its "
+                    "subroutine path; examples/linuxcnc/README.md)");
   compile->add_option("--report", compile_options.report,
                       "also write a JSON report of every motion target (required and nominal position, correction, "
                       "region, residual, budget) and the cycle-time estimate");
-  compile->callback([&options] { RunCompile(compile_options, options); });
+  compile->callback([&options] {
+    if (compile_options.dry_run_probe && compile_options.target != "linuxcnc") {
+      fmt::print(stderr, "smtcal: error: --dry-run-probe needs --target linuxcnc\n");
+      options.exit_code = kExitUsageError;
+      return;
+    }
+    RunCompile(compile_options, options);
+  });
 
   static CompileOptions verify_options;
   CLI::App* verify = app.add_subcommand(

@@ -42,6 +42,10 @@ void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
     options.exit_code = kExitUsageError;
     return;
   }
+  if (OutputOverwritesInput("--svg", opt.svg_path, {opt.old_path, opt.new_path, opt.cell_path})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Result<std::uint32_t> old_file = sources.Load(opt.old_path);
   if (!old_file) {

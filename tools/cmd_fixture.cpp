@@ -10,8 +10,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "base/json_text.h"
 #include "calibration/fixture_estimation.h"
 #include "frontend/cell_toml.h"
+#include "frontend/previous_scan_json.h"
 #include "frontend/trips_csv.h"
 #include "tools/commands.h"
 
@@ -42,85 +44,6 @@ std::string Fixed(double value, int decimals) {
   std::string text = fmt::format("{:.{}f}", value, decimals);
   if (text.find_first_not_of("-0.") == std::string::npos && text.front() == '-') text.erase(0, 1);
   return text;
-}
-
-// ------------------------------------------------------------------ --previous
-
-bool SameName(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  }
-  return true;
-}
-
-// Where a byte offset of the file is (for JSON parse errors).
-SourceLoc LocationOf(const SourceManager& sources, std::uint32_t file, std::size_t offset) {
-  const SourceFile& source = sources.File(file);
-  std::uint32_t line = 1;
-  for (std::size_t i = 1; i < source.line_starts.size() && source.line_starts[i] <= offset; ++i) line = i + 1;
-  const std::size_t start = source.line_starts.empty() ? 0 : source.line_starts[line - 1];
-  return SourceLoc{file, line, static_cast<std::uint32_t>(offset - start + 1)};
-}
-
-// FIX_{n-1} from a previous `smtcal fixture --json` output. nullopt after
-// reporting what is wrong with it.
-std::optional<Eigen::Affine3d> ReadPrevious(std::uint32_t file, const cell::Fixture& fixture, Diagnostics& diags) {
-  const SourceManager& sources = diags.sources();
-  const SourceRange whole(SourceLoc{file, 0, 0});
-  ordered_json json;
-  try {
-    json = ordered_json::parse(sources.File(file).text);
-  } catch (const ordered_json::parse_error& e) {
-    const std::size_t offset = e.byte == 0 ? 0 : e.byte - 1;
-    diags.Report(DiagKind::PreviousScanInvalid, SourceRange(LocationOf(sources, file, offset)),
-                 "it is not valid JSON");
-    return std::nullopt;
-  }
-  if (!json.is_object() || !json.contains("fixture") || !json["fixture"].is_string() || !json.contains("fix") ||
-      !json.contains("checks")) {
-    diags.Report(DiagKind::PreviousScanInvalid, whole, "it has no \"fixture\", \"fix\" and \"checks\"");
-    return std::nullopt;
-  }
-  const std::string name = json["fixture"].get<std::string>();
-  if (!SameName(name, fixture.name)) {
-    diags.Report(DiagKind::PreviousScanOtherFixture, whole, name, fixture.name);
-    return std::nullopt;
-  }
-  if (json["fix"].is_null()) {
-    const std::string fault = json.contains("fault") && json["fault"].is_string() ? json["fault"].get<std::string>()
-                                                                                    : std::string("?");
-    diags.Report(DiagKind::PreviousScanNoPose, whole, fault);
-    return std::nullopt;
-  }
-  const ordered_json& matrix = json["fix"].is_object() && json["fix"].contains("matrix") ? json["fix"]["matrix"]
-                                                                                         : ordered_json();
-  Eigen::Matrix4d m;
-  bool ok = matrix.is_array() && matrix.size() == 4;
-  for (std::size_t r = 0; ok && r < 4; ++r) {
-    ok = matrix[r].is_array() && matrix[r].size() == 4;
-    for (std::size_t c = 0; ok && c < 4; ++c) {
-      ok = matrix[r][c].is_number() && std::isfinite(matrix[r][c].get<double>());
-      if (ok) m(static_cast<long>(r), static_cast<long>(c)) = matrix[r][c].get<double>();
-    }
-  }
-  if (!ok) {
-    diags.Report(DiagKind::PreviousScanInvalid, whole, "\"fix\".\"matrix\" is not a 4 x 4 matrix of numbers");
-    return std::nullopt;
-  }
-  Eigen::Matrix4d planar = Eigen::Matrix4d::Identity();
-  planar.topLeftCorner<2, 2>() = m.topLeftCorner<2, 2>();
-  planar.block<2, 1>(0, 3) = m.block<2, 1>(0, 3);
-  const double det = m.topLeftCorner<2, 2>().determinant();
-  if (m != planar || !(std::abs(det) > 0.5)) {
-    diags.Report(DiagKind::PreviousScanInvalid, whole,
-                 "\"fix\".\"matrix\" is not a planar FIX (rows 3 and 4 must be 0 0 1 0 and 0 0 0 1, the x-y part "
-                 "a rotation)");
-    return std::nullopt;
-  }
-  Eigen::Affine3d fix;
-  fix.matrix() = m;
-  return fix;
 }
 
 // ------------------------------------------------------------------ output
@@ -312,7 +235,7 @@ std::string Json(const cell::Cell& cell, const cell::Fixture& fixture, const std
     checks.push_back(entry);
   }
   out["checks"] = checks;
-  return out.dump(2) + "\n";
+  return JsonText(out);
 }
 
 // The failed check as a diagnostic: at the trip's row when it concerns one
@@ -367,7 +290,7 @@ void Run(const FixtureOptions& opt, GlobalOptions& options) {
       options.exit_code = ReportIoError(previous_file.error());
       return;
     }
-    scan_options.previous = ReadPrevious(previous_file.value(), *fixture, diags);
+    scan_options.previous = ReadPreviousScan(previous_file.value(), *fixture, diags);
   }
   if (!rows || diags.has_errors()) {
     options.exit_code = PrintDiagnostics(diags, options);
@@ -398,7 +321,8 @@ void AddFixtureCommand(CLI::App& app, GlobalOptions& options) {
   command->add_option("--fixture", opt.fixture, "the fixture's name in the cell (case-insensitive)")->required();
   command->add_option("--trips", opt.trips,
                       "the trip points: CSV name,x_mm,y_mm[,z_mm], one row per trip T1..Tn in the robot\n"
-                      "base frame as commanded when the sensor tripped ('-' for stdin)")
+                      "base frame as commanded when the sensor tripped ('-' for stdin); a trip without a row\n"
+                      "is missing, and a header without rows is a scan in which no trip was recorded")
       ->required();
   command->add_option("--estimator", opt.estimator,
                       "paper (Eq. 4 on the fitted lines' crossings), rigid (least squares over all trips:\n"

@@ -10,6 +10,7 @@
 
 #include <fmt/core.h>
 
+#include "base/json_text.h"
 #include "backend/reports/compile_report.h"
 #include "backend/reports/simulate_report.h"
 #include "calibration/cell.h"
@@ -88,10 +89,18 @@ bool FitsInMemory(const CompileState& state, const SimOptions& sim, GlobalOption
 }
 
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
+  if (OutputOverwritesInput("--svg", opt.svg, {opt.program_path, opt.cell_path, opt.truth_path})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  // verify's verdicts on accuracy are what the simulation measures: they do
+  // not stop it, the report says how many there were.
+  const std::size_t over_budget =
+      diags.Remove(DiagKind::BudgetOverTolerance) + diags.Remove(DiagKind::FixtureBudgetUnbounded);
   if (diags.has_errors()) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
@@ -113,14 +122,15 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
 
   if (!FitsInMemory(state, opt.sim, options)) return;
   SimResult result = Simulate(state, truth, opt.sim);
-  SimulateContext context{opt.program_path, &*compiled.cell, &truth};
+  SimulateContext context{opt.program_path, &*compiled.cell, &truth, over_budget};
   if (!opt.svg.empty()) {
     if (Status written = WriteFileAtomically(opt.svg, SimulateReportSvg(result, context)); !written) {
       options.exit_code = ReportIoError(written.error());
       return;
     }
   }
-  fmt::print("{}", opt.json ? SimulateReportJson(result, context).dump(2) + "\n" : SimulateReportText(result, context));
+  std::string text = opt.json ? JsonText(SimulateReportJson(result, context)) : SimulateReportText(result, context);
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
 }
 
 }  // namespace

@@ -61,7 +61,15 @@ OutsidePolicy ParsePolicy(const std::string& name) {
   return OutsidePolicy::kError;
 }
 
+// The output options of `table` never name the command's own inputs.
+bool OutputIsInput(const TableOptions& opt, GlobalOptions& options) {
+  if (!OutputOverwritesInput("-o", opt.output, {opt.input, opt.points})) return false;
+  options.exit_code = kExitUsageError;
+  return true;
+}
+
 void RunBuild(const TableOptions& opt, GlobalOptions& options) {
+  if (OutputIsInput(opt, options)) return;
   SourceManager sources;
   Result<std::uint32_t> file = sources.Load(opt.input);
   if (!file) {
@@ -103,6 +111,7 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
+  if (OutputIsInput(opt, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   TableAnalysis analysis;
@@ -151,6 +160,7 @@ void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
 }
 
 void RunPlot(const TableOptions& opt, GlobalOptions& options) {
+  if (OutputIsInput(opt, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);

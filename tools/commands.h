@@ -3,6 +3,8 @@
 #pragma once
 
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -29,6 +31,12 @@ struct GlobalOptions {
 int PrintDiagnostics(const Diagnostics& diags, const GlobalOptions& options);
 // Prints "smtcal: error: <message>" to stderr and returns kExitIoError.
 int ReportIoError(const Error& error);
+
+// True, after printing why, when the output file `output` (given with
+// `option`, e.g. "-o") is one of `inputs` or a folder holding one: the
+// command must then stop with kExitUsageError before reading anything.
+bool OutputOverwritesInput(std::string_view option, const std::string& output,
+                           const std::vector<std::string>& inputs);
 
 void AddCheckCommand(CLI::App& app, GlobalOptions& options);
 void AddFmtCommand(CLI::App& app, GlobalOptions& options);

@@ -8,7 +8,8 @@ packages=(
   antlr4 libantlr4-runtime-dev default-jre-headless
   libeigen3-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libfast-float-dev
   libgtest-dev libbenchmark-dev libmimalloc-dev
-  linuxcnc-uspace
+  clang-14 libclang-rt-14-dev  # the fuzz harnesses: clang and its libFuzzer runtime (tests/fuzz/)
+  linuxcnc-uspace iproute2
   locales
 )
 

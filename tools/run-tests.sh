@@ -2,8 +2,14 @@
 # Builds smtcal and runs every test (unit, golden, integration) with CTest.
 #   bash tools/run-tests.sh              # build/ , RelWithDebInfo
 #   bash tools/run-tests.sh --sanitize   # build-asan/, AddressSanitizer + UBSan
+#   bash tools/run-tests.sh --fuzz [S]   # build-fuzz/, every libFuzzer harness for S s (default 30)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+if [ "${1:-}" = "--fuzz" ]; then
+  bash tools/install-deps.sh
+  exec bash tests/fuzz/run-fuzzers.sh "${2:-30}"
+fi
 
 build_dir=build
 cmake_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo)

@@ -296,4 +296,15 @@ std::string EmitCRuntimeData(const cell::Cell& cell, const std::vector<CRuntimeP
   return out + "};\n";
 }
 
+std::vector<CRuntimePoint> CRuntimeFixturePoints(const CompileState& state) {
+  std::vector<CRuntimePoint> points;
+  for (const Target& target : state.targets) {
+    if (target.kind != CorrectionKind::kFixture || !target.known) continue;
+    points.push_back(CRuntimePoint{target.text, state.fixtures[target.fixture].cell_fixture->name,
+                                   Eigen::Vector2d(target.in_frame[0], target.in_frame[1]), target.in_frame[2],
+                                   target.in_frame[3], target.stmt->loc});
+  }
+  return points;
+}
+
 }  // namespace smtcal

@@ -16,6 +16,7 @@
 
 #include "base/source.h"
 #include "calibration/cell.h"
+#include "passes/correction/compile_state.h"
 #include "runtime/c/smtcal_runtime.h"
 
 namespace smtcal {
@@ -66,6 +67,10 @@ smtcal_fixture CRuntimeFixture(const cell::Fixture& fixture);
 // must be in the cell (checked).
 std::string EmitCRuntimeData(const cell::Cell& cell, const std::vector<CRuntimePoint>& points,
                              std::string_view program_name);
+
+// The program's fixture targets whose position is known at compile time, as
+// points for EmitCRuntimeData.
+std::vector<CRuntimePoint> CRuntimeFixturePoints(const CompileState& state);
 
 // The identifier EmitCRuntimeData gives the program structure.
 std::string CRuntimeProgramSymbol(std::string_view program_name);

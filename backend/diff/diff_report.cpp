@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/reports/svg_text.h"
+#include "base/json_text.h"
 
 namespace smtcal::diff {
 namespace {
@@ -199,7 +200,7 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
   }
   summary["gate"] = s.gate_passes() ? "passed" : "failed";
   root["summary"] = summary;
-  return root.dump(2) + "\n";
+  return JsonText(root);
 }
 
 // ------------------------------------------------------------------ SVG

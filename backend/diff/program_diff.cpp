@@ -749,14 +749,7 @@ class Differ {
   }
 
   // `smtcal compile --target place` output opens with this comment.
-  static bool IsCompiled(const ir::Program& program) {
-    for (const ir::StmtPtr& stmt : program.items) {
-      const auto* comment = std::get_if<ir::Comment>(&stmt->node);
-      if (comment == nullptr) return false;
-      if (comment->text.rfind(" Corrected by smtcal ", 0) == 0) return true;
-    }
-    return false;
-  }
+  static bool IsCompiled(const ir::Program& program) { return ir::CorrectedHeader(program) != nullptr; }
 
   // ---------------------------------------------------------------- declarations
 

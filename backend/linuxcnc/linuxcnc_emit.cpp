@@ -33,6 +33,8 @@
 
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_dry_run.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "ir/constant_fold.h"
 #include "ir/ir_text.h"
 #include "ir/ir_walk.h"
@@ -346,7 +348,7 @@ class Emitter {
     // The abort's own text is the message; the location is inside it.
     std::string& out = Begin();
     const std::size_t begin = out.size();
-    fmt::format_to(std::back_inserter(out), "(abort, smtcal: {} at {})\n", SanitizeMessage(message),
+    fmt::format_to(std::back_inserter(out), "(abort,smtcal: {} at {})\n", SanitizeMessage(message),
                    SanitizeMessage(Where(loc)));
     Ended(begin, loc);
   }
@@ -927,11 +929,11 @@ class Emitter {
     ++indent_;
     block("o<pick_place_held> if [#8 EQ 1]");
     ++indent_;
-    block(fmt::format("(abort, smtcal: Pick at {}:%d#9: vacuum sensor input {} did not report the part held within {} s)",
+    block(fmt::format("(abort,smtcal: Pick at {}:%d#9: vacuum sensor input {} did not report the part held within {} s)",
                       where, sensor, timeout));
     --indent_;
     block("o<pick_place_held> endif");
-    block(fmt::format("(abort, smtcal: Place at {}:%d#9: vacuum sensor input {} did not report the part released within {} s)",
+    block(fmt::format("(abort,smtcal: Place at {}:%d#9: vacuum sensor input {} did not report the part released within {} s)",
                       where, sensor, timeout));
     --indent_;
     block("o<pick_place_agreed> endif");
@@ -985,7 +987,7 @@ std::string NotOurOutput(const fs::path& dir) {
   if (!fs::is_directory(dir)) return fmt::format("'{}' exists and is not a directory", dir.string());
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const fs::path& path = entry.path();
-    if (entry.is_directory() && path.filename() == "subroutines") {
+    if (entry.is_directory() && (path.filename() == "subroutines" || path.filename() == kLinuxCncDryRunFolder)) {
       for (const fs::directory_entry& sub : fs::directory_iterator(path)) {
         std::string name = sub.path().filename().string();
         if (!sub.is_regular_file() || !name.starts_with("smtcal_") || sub.path().extension() != ".ngc") {
@@ -1040,6 +1042,7 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   output.main_name = LinuxCncMainName(program_path);
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
+  output.subroutines.push_back({"smtcal_scan_abort.ngc", EmitLinuxCncScanAbort(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
             [](const EmbeddedFile& a, const EmbeddedFile& b) { return a.name < b.name; });
   return output;
@@ -1048,7 +1051,12 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
 std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view main_text) {
   std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, main_text);
   for (const EmbeddedFile& file : output.subroutines) {
-    if (file.name == "smtcal_data.ngc") text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
+    if (file.name == "smtcal_data.ngc" || file.name == "smtcal_scan_abort.ngc") {
+      text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
+    }
+  }
+  for (const EmbeddedFile& file : output.dry_run) {
+    text += fmt::format("(smtcal file: {}/{})\n{}", kLinuxCncDryRunFolder, file.name, file.text);
   }
   return text;
 }
@@ -1089,6 +1097,14 @@ Status LinuxCncDirectory::Commit(const LinuxCncOutput& output) {
   for (const EmbeddedFile& file : output.subroutines) {
     if (!written) break;
     written = WriteText(temp_ / "subroutines" / file.name, file.text);
+  }
+  if (written && !output.dry_run.empty()) {
+    fs::create_directories(temp_ / kLinuxCncDryRunFolder, error);
+    if (error) written = Error{fmt::format("cannot create '{}': {}", (temp_ / kLinuxCncDryRunFolder).string(), error.message())};
+  }
+  for (const EmbeddedFile& file : output.dry_run) {
+    if (!written) break;
+    written = WriteText(temp_ / kLinuxCncDryRunFolder / file.name, file.text);
   }
   if (!written) return written;
   if (!replaces_) {

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "backend/reports/capability_report.h"
 #include "calibration/error_table.h"
 
 namespace smtcal {
@@ -29,6 +30,25 @@ std::string FixtureName(const CompileState& state, int fixture) {
 }
 
 }  // namespace
+
+std::vector<std::pair<std::string, Capability>> PredictedCapability(const CompileState& state) {
+  std::map<std::string, ModelCapability> by_region;
+  ModelCapability overall;
+  std::vector<std::string> order;
+  for (const Target& target : state.targets) {
+    if (!target.is_placement() || !target.known || target.region == nullptr || !target.budget_bounded) continue;
+    if (target.kind == CorrectionKind::kUncorrected) continue;
+    const ErrorShare total = state.BudgetOf(target).Total();
+    const double tolerance = target.region->tolerance_mm;
+    if (!by_region.contains(target.region->name)) order.push_back(target.region->name);
+    by_region[target.region->name].Add(total.mean_mm, total.bound_mm, total.covariance_mm2, tolerance);
+    overall.Add(total.mean_mm, total.bound_mm, total.covariance_mm2, tolerance);
+  }
+  std::vector<std::pair<std::string, Capability>> result;
+  for (const std::string& name : order) result.emplace_back(name, by_region.at(name).Result());
+  if (!order.empty()) result.emplace_back("overall", overall.Result());
+  return result;
+}
 
 std::string LocationText(const SourceManager& sources, SourceLoc loc) {
   if (!loc.known()) return "<unknown>";
@@ -58,8 +78,17 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
     entry["residual_mm"] = target.residual_mm;
     entry["iterations"] = target.iterations;
     entry["iteration_bound"] = target.iteration_bound;
-    entry["sensor_share_mm"] = target.sensor_share_mm;
-    entry["budget_mm"] = target.budget_mm;
+    if (target.kind != CorrectionKind::kUncorrected) {
+      const ErrorBudget budget = state.BudgetOf(target);
+      json parts = json::object();
+      for (std::size_t k = 0; k < kErrorSources; ++k) {
+        parts[std::string(ErrorSourceName(static_cast<ErrorSource>(k)))] = RoundedJson(budget.shares[k].BudgetMm(), 6);
+      }
+      entry["budget_mm"] = RoundedJson(target.budget_mm, 6);
+      entry["budget_bounded"] = target.budget_bounded;
+      entry["budget_parts_mm"] = std::move(parts);
+      entry["worst_case_mm"] = RoundedJson(target.worst_case_mm, 6);
+    }
     if (target.region != nullptr) entry["tolerance_mm"] = target.region->tolerance_mm;
     targets.push_back(std::move(entry));
   }
@@ -90,6 +119,8 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
                           {"total_s", total},
                           {"scan_share", total > 0 ? cycle.scan_s / total : 0.0}});
   }
+  json process = json::object();
+  for (const auto& [name, capability] : PredictedCapability(state)) process[name] = CapabilityJson(capability);
   return json{{"program", sources.File(program.file).name},
               {"cell", state.cell->path},
               {"errors", counts.errors},
@@ -98,7 +129,8 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
               {"fixtures", fixtures},
               {"taught_points", taught},
               {"targets", targets},
-              {"cycles", cycles}};
+              {"cycles", cycles},
+              {"process", process}};
 }
 
 std::string VerifySummaryText(const ir::Program& program, const CompileState& state, const SourceManager& sources,
@@ -135,11 +167,23 @@ std::string VerifySummaryText(const ir::Program& program, const CompileState& st
   if (worst_residual != nullptr) {
     text += fmt::format("  worst residual: {:.1e} mm, {}\n", worst_residual->residual_mm, describe(*worst_residual));
   }
-  if (worst_budget != nullptr) {
-    text += fmt::format("  worst budget: {:.4f} mm of ±{} mm (residual {:.1e} + repeatability {} + sensor {:.4f}), {}\n",
+  if (worst_budget != nullptr && worst_budget->budget_bounded) {
+    const ErrorBudget budget = state.BudgetOf(*worst_budget);
+    text += fmt::format("  worst budget: {:.4f} mm at 4σ of ±{} mm (worst case {:.4f} mm), {}\n",
                         worst_budget->budget_mm, FormatMm(worst_budget->region->tolerance_mm),
-                        worst_budget->residual_mm, FormatMm(state.cell->robot.repeatability_mm),
-                        worst_budget->sensor_share_mm, describe(*worst_budget));
+                        worst_budget->worst_case_mm, describe(*worst_budget));
+    std::string parts;
+    for (std::size_t k = 0; k < kErrorSources; ++k) {
+      if (budget.shares[k].BudgetMm() == 0) continue;
+      parts += fmt::format("{}{} {:.4f}", parts.empty() ? "" : ", ", ErrorSourceName(static_cast<ErrorSource>(k)),
+                           budget.shares[k].BudgetMm());
+    }
+    text += fmt::format("    its parts, each alone at 4σ (mm): {}\n", parts);
+  }
+  const auto process = PredictedCapability(state);
+  if (!process.empty()) {
+    text += "  process, from the budget's model (normal assumption):\n";
+    for (const auto& [name, capability] : process) text += "    " + CapabilityLine(name, capability) + "\n";
   }
   for (const CycleEstimate& cycle : state.cycles) {
     double total = cycle.total_s();

@@ -4,10 +4,13 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "base/source.h"
+#include "calibration/capability.h"
 #include "ir/ir.h"
 #include "passes/correction/compile_state.h"
 
@@ -23,6 +26,11 @@ struct ReportCounts {
 // and the cycle-time estimates. Deterministic: targets in order first reached.
 nlohmann::json CompileReportJson(const ir::Program& program, const CompileState& state, const SourceManager& sources,
                                  ReportCounts counts);
+
+// The process figures verify predicts from the budget's model, per region
+// (in order of first placement) and "overall": Place targets known at
+// compile time with a bounded budget.
+std::vector<std::pair<std::string, Capability>> PredictedCapability(const CompileState& state);
 
 // "file:line:col" of a location in the program.
 std::string LocationText(const SourceManager& sources, SourceLoc loc);

@@ -8,7 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "backend/reports/capability_report.h"
 #include "backend/reports/svg_text.h"
+#include "base/field_text.h"
 
 namespace smtcal {
 namespace {
@@ -37,7 +39,10 @@ double WithinFraction(const ModeResult& m) {
 }
 
 // Rounded for the JSON report: a thousandth of a micrometre, a millionth of a fraction.
-double Round(double value, double unit) { return std::round(value / unit) * unit; }
+// A figure rounded to its meaning: `unit` is a power of ten (1e-3, 1e-6).
+double Round(double value, double unit) {
+  return RoundedToDecimals(value, static_cast<int>(std::lround(-std::log10(unit))));
+}
 
 std::string_view ShiftName(ShiftDistribution shift) {
   switch (shift) {
@@ -83,6 +88,16 @@ std::string BoardText(const BoardPoseModel& board) {
 constexpr std::array<const char*, 6> kModeColours = {"#7f7f7f", "#bcbd22", "#1f77b4",
                                                      "#9467bd", "#ff7f0e", "#2ca02c"};
 
+nlohmann::json ProcessJson(const ModeResult& m, const SimResult& result) {
+  if (m.placements == 0) return nullptr;
+  nlohmann::json regions = nlohmann::json::object();
+  for (std::size_t r = 0; r < m.by_region.size(); ++r) {
+    const Capability c = m.by_region[r].Result();
+    if (c.placements > 0) regions[result.regions[r]] = CapabilityJson(c);
+  }
+  return {{"overall", CapabilityJson(m.overall.Result())}, {"regions", regions}};
+}
+
 }  // namespace
 
 std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
@@ -92,8 +107,19 @@ std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
                          : " (noise off: the tables as they are)";
   }
   if (!truth.region_tables.empty()) field += fmt::format(", {} true table(s) given", truth.region_tables.size());
-  field += truth.outside == TruthOutside::kFade ? fmt::format(", outside fading to 0 over {} mm", truth.fade_mm)
-                                                : std::string(", outside clamped to the edge values");
+  switch (truth.outside) {
+    case TruthOutside::kField: {
+      const std::optional<double> declared =
+          truth.uncalibrated_accuracy_mm ? truth.uncalibrated_accuracy_mm : cell.robot.uncalibrated_accuracy_mm;
+      field += fmt::format(
+          ", outside a smooth random field up to {} mm{} (correlation {} mm)", declared.value_or(kAssumedUncalibratedAccuracyMm),
+          declared ? "" : " (ASSUMED: the cell does not declare robot.uncalibrated_accuracy_mm)",
+          truth.uncalibrated_correlation_mm.value_or(cell.robot.uncalibrated_correlation_mm));
+      break;
+    }
+    case TruthOutside::kFade: field += fmt::format(", outside fading to 0 over {} mm", truth.fade_mm); break;
+    case TruthOutside::kClamp: field += ", outside clamped to the edge values"; break;
+  }
   if (truth.offset_mm != Eigen::Vector2d::Zero()) {
     field += fmt::format(", offset ({}, {}) mm", truth.offset_mm.x(), truth.offset_mm.y());
   }
@@ -101,8 +127,10 @@ std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
     field += fmt::format(", rotation {}° and scale {} ppm about ({}, {})", truth.rotation_deg, truth.scale_ppm,
                          truth.about_mm.x(), truth.about_mm.y());
   }
-  return fmt::format("{}; {}; sensor ±{} mm, repeatability ±{} mm (uniform){}", field, BoardText(truth.board),
-                     SensorAccuracy(truth, cell), Repeatability(truth, cell), truth.noise ? "" : ", noise off");
+  const double servo_period_s = truth.noise ? truth.servo_period_s.value_or(cell.robot.servo_period_s) : 0.0;
+  return fmt::format("{}; {}; sensor ±{} mm, repeatability ±{} mm (uniform), trips latched up to {} s late{}", field,
+                     BoardText(truth.board), SensorAccuracy(truth, cell), Repeatability(truth, cell), servo_period_s,
+                     truth.noise ? "" : ", noise off");
 }
 
 std::string SimulateReportText(const SimResult& result, const SimulateContext& context) {
@@ -118,6 +146,11 @@ std::string SimulateReportText(const SimResult& result, const SimulateContext& c
   }
   if (result.unknown_targets > 0) {
     out += fmt::format("not simulated: {} placement(s) known only at run time\n", result.unknown_targets);
+  }
+  if (context.verify_findings > 0) {
+    out += fmt::format("smtcal verify refuses this program: {} finding(s) on its tolerance budget (run smtcal verify "
+                       "for them); simulated anyway\n",
+                       context.verify_findings);
   }
   out += fmt::format("\n{:<12} {:>9} {:>10} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>6}\n", "mode", "placed",
                      "within", "out", "faults", "mean", "p50", "p95", "p99", "max", "scan");
@@ -151,6 +184,24 @@ std::string SimulateReportText(const SimResult& result, const SimulateContext& c
     for (const ModeResult& m : result.modes) {
       out += fmt::format("  {:<12} stopped {:>6}   misplaced {:>6}\n", SimModeName(m.mode), m.faults_injected,
                          m.misplaced_injected);
+    }
+  }
+  out += fmt::format("\nprocess figures (per axis; a normal fitted to the placed parts' errors; Cmk at each "
+                     "part's tolerance; the placement industry's reference: ±{} µm at 4σ, Cmk ≥ {}):\n",
+                     kReferenceToleranceMm * 1000, kReferenceCmk);
+  for (const ModeResult& m : result.modes) {
+    if (m.placements == 0) {
+      out += fmt::format("  {:<12} nothing placed\n", SimModeName(m.mode));
+      continue;
+    }
+    out += fmt::format("  {:<12} {}\n", SimModeName(m.mode), CapabilityLine("all", m.overall.Result()));
+  }
+  for (const ModeResult& m : result.modes) {
+    if (m.mode != SimMode::kImproved || m.placements == 0) continue;
+    out += "  improved, per region:\n";
+    for (std::size_t r = 0; r < m.by_region.size(); ++r) {
+      const Capability c = m.by_region[r].Result();
+      if (c.placements > 0) out += "    " + CapabilityLine(result.regions[r], c) + "\n";
     }
   }
   out += "\nmodes:\n";
@@ -187,7 +238,8 @@ nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext
                                                                      {"p95", Round(s.p95, 1e-3)},
                                                                      {"p99", Round(s.p99, 1e-3)},
                                                                      {"max", Round(s.max, 1e-3)}}},
-                     {"scan_share", Round(m.scan_share, 1e-6)}});
+                     {"scan_share", Round(m.scan_share, 1e-6)},
+                     {"process", ProcessJson(m, result)}});
   }
   return {{"program", context.program},
           {"cell", context.cell->name},
@@ -199,6 +251,9 @@ nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext
           {"placements_planned", result.placements_planned},
           {"placements_not_simulated", result.unknown_targets},
           {"improved_estimator", result.fixture_estimator},
+          {"verify_budget_findings", context.verify_findings},
+          {"uncalibrated_accuracy_mm", result.uncalibrated_accuracy_mm},
+          {"uncalibrated_accuracy_assumed", result.accuracy_assumed},
           {"injected",
            {{"missed_trip", {{"rate", o.missed_trip_rate}, {"cycles", result.injected_missed}}},
             {"dirty_marker",

@@ -19,6 +19,9 @@ struct SimulateContext {
   std::string program;  // the program file as given
   const cell::Cell* cell = nullptr;
   const TruthSpec* truth = nullptr;
+  // verify's findings the simulation measures instead of stopping for them:
+  // targets over their budget, fixtures whose budget cannot be bounded.
+  std::size_t verify_findings = 0;
 };
 
 // Per mode: placed parts, the fraction within tolerance, faults, the error

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "base/json_text.h"
+
 namespace smtcal {
 namespace {
 
@@ -158,7 +160,7 @@ std::string FormatStatsJson(const ErrorTable& table, const TableStats& stats, co
                      {"min_jacobian_det", Round6(analysis.min_jacobian_det)},
                      {"iteration_bound", iteration_bound},
                      {"residual_tolerance_mm", kInverseResidualTolMm}};
-  return root.dump(2) + "\n";
+  return JsonText(root);
 }
 
 std::string FormatSolutionsCsv(const std::vector<Solution>& solutions) {

@@ -143,7 +143,8 @@ class CheckReachability final : public Pass {
 
   // Depth-first search in source order; a call to a function still on the
   // stack closes a cycle. Every function of a reported cycle is marked so
-  // the same cycle is not reported again from another entry.
+  // the same cycle is not reported again from another entry. The stack is
+  // our own, not the machine's: a chain of 200 000 calls is a valid program.
   void Recursion(const std::vector<const ir::Stmt*>& functions) {
     for (const ir::Stmt* stmt : functions) {
       const auto* function = &std::get<ir::Function>(stmt->node);
@@ -151,29 +152,40 @@ class CheckReachability final : public Pass {
     }
   }
 
-  void Visit(const ir::Function* function) {
-    stack_.push_back({function, nullptr});
-    on_stack_.insert(function);
-    for (const CallEdge& edge : calls_[function]) {
-      stack_.back().call = edge.call;
-      if (on_stack_.count(edge.callee) != 0) {
-        ReportCycle(edge.callee);
+  void Visit(const ir::Function* root) {
+    Enter(root);
+    while (!stack_.empty()) {
+      Frame& top = stack_.back();
+      const std::vector<CallEdge>& edges = calls_[top.function];
+      if (top.next_edge == edges.size()) {
+        on_stack_.erase(top.function);
+        done_.insert(top.function);
+        stack_.pop_back();
+        continue;
+      }
+      const CallEdge& edge = edges[top.next_edge++];
+      top.call = edge.call;
+      if (auto on_stack = on_stack_.find(edge.callee); on_stack != on_stack_.end()) {
+        ReportCycle(on_stack->second);
       } else if (done_.count(edge.callee) == 0) {
-        Visit(edge.callee);
+        Enter(edge.callee);  // `top` is not used after this
       }
     }
-    stack_.pop_back();
-    on_stack_.erase(function);
-    done_.insert(function);
   }
 
-  // The stack from `target` to the top, each with the call it made next.
-  void ReportCycle(const ir::Function* target) {
-    auto begin = std::find_if(stack_.begin(), stack_.end(), [&](const Frame& f) { return f.function == target; });
-    std::vector<Frame> cycle(begin, stack_.end());
-    for (const Frame& frame : cycle) {
-      if (in_reported_cycle_.count(frame.function) != 0) return;
+  void Enter(const ir::Function* function) {
+    on_stack_.emplace(function, stack_.size());
+    stack_.push_back({function, nullptr, 0});
+  }
+
+  // The stack from position `first` (the called function) to the top, each
+  // with the call it made next.
+  void ReportCycle(std::size_t first) {
+    const ir::Function* target = stack_[first].function;
+    for (std::size_t i = first; i < stack_.size(); ++i) {
+      if (in_reported_cycle_.count(stack_[i].function) != 0) return;
     }
+    std::vector<Frame> cycle(stack_.begin() + static_cast<std::ptrdiff_t>(first), stack_.end());
     std::string path;
     for (const Frame& frame : cycle) path += fmt::format("'{}' -> ", frame.function->name);
     path += fmt::format("'{}'", target->name);
@@ -192,7 +204,8 @@ class CheckReachability final : public Pass {
 
   struct Frame {
     const ir::Function* function;
-    const ir::Stmt* call;  // the call being followed
+    const ir::Stmt* call;       // the call being followed
+    std::size_t next_edge = 0;  // index into calls_[function]
   };
 
   Diagnostics* diags_ = nullptr;
@@ -200,7 +213,7 @@ class CheckReachability final : public Pass {
   bool warned_after_ = false;
   std::map<const ir::Function*, std::vector<CallEdge>> calls_;
   std::vector<Frame> stack_;
-  std::set<const ir::Function*> on_stack_;
+  std::map<const ir::Function*, std::size_t> on_stack_;  // its index in stack_
   std::set<const ir::Function*> done_;
   std::set<const ir::Function*> in_reported_cycle_;
 };

@@ -2,7 +2,8 @@
 //
 // Assumes: a program that passed the checks; program.compile made by the
 // compile driver with its cell set (passes/correction/compile_state.h).
-// Guarantees when it reports no error: every program fixture is bound to the
+// Guarantees when it reports no error: the program is not smtcal output (its
+// static targets would be corrected twice); every program fixture is bound to the
 // cell's fixture of that name with its nominal pose; every fixture that
 // carries taught points has FIX_0 from its teach-time scan; no pallet has
 // taught corners; state.targets holds every motion target the program can
@@ -13,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "ir/ir_ops.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
 #include "passes/correction/correction_passes.h"
@@ -30,6 +32,12 @@ class Bind final : public Pass {
                  "bind runs only when compiling for a cell");
     CompileState& state = *program.compile;
     const cell::Cell& cell = *state.cell;
+    if (const ir::Stmt* header = ir::CorrectedHeader(program)) {
+      // Its static targets are already commands: correcting them again
+      // would move every one by the table's error a second time.
+      diags.Report(DiagKind::ProgramIsCompiledOutput, SourceRange(header->loc));
+      return;
+    }
     const sema::SymbolTable& symbols = sema::SymbolsOf(program);
 
     for (const ir::StmtPtr& item : program.items) {
@@ -42,7 +50,7 @@ class Bind final : public Pass {
       }
       if (const auto* pallet = std::get_if<ir::PalletDecl>(&item->node)) CheckPalletCorners(*item, *pallet, symbols, diags);
     }
-    TraceTargets(program, symbols, state);
+    TraceTargets(program, symbols, state, diags);
     if (!state.trace_complete) {
       const sema::Symbol* main = symbols.Find("Main");
       diags.Report(DiagKind::TraceIncomplete, main != nullptr ? main->range : SourceRange{}, kMaxTraceSteps);

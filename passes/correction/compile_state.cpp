@@ -66,10 +66,18 @@ TeachPose EstimateTeachPose(const cell::Fixture& fixture, const cell::Cell& cell
   return {std::nullopt, DescribeFailure(scan, fixture)};
 }
 
-double CompileState::SensorShareAt(const cell::Fixture& fixture, const Eigen::Vector2d& point_in_fixture) {
-  std::unique_ptr<SensorShare>& share = sensor_shares_[&fixture];
-  if (!share) share = std::make_unique<SensorShare>(fixture);
-  return share->AtMm(point_in_fixture);
+const FixtureErrorModel& CompileState::ErrorModelFor(const cell::Fixture& fixture) const {
+  std::unique_ptr<FixtureErrorModel>& model = error_models_[&fixture];
+  if (!model) model = std::make_unique<FixtureErrorModel>(*cell, fixture);
+  return *model;
+}
+
+ErrorBudget CompileState::BudgetOf(const Target& target) const {
+  if (target.kind == CorrectionKind::kFixture) {
+    return ErrorModelFor(*fixtures[target.fixture].cell_fixture).At(Xy(target.in_frame), target.region,
+                                                                     target.residual_mm);
+  }
+  return StaticBudget(*cell, target.region, target.residual_mm);
 }
 
 std::string_view TargetKeyword(const ir::Stmt& stmt) {

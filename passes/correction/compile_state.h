@@ -29,6 +29,7 @@
 #include "calibration/cell.h"
 #include "calibration/fixture_estimation.h"
 #include "calibration/inverse_calibration.h"
+#include "calibration/placement_budget.h"
 #include "ir/ir.h"
 
 namespace smtcal {
@@ -104,8 +105,11 @@ struct Target {
   double residual_mm = 0;
   int iterations = 0;
   int iteration_bound = 0;   // fixture and run-time targets: what the runtime may need
-  double sensor_share_mm = 0;
-  double budget_mm = 0;       // residual + repeatability + sensor share
+  // The tolerance budget (verify; calibration/placement_budget.h): at 4
+  // sigma, and the hard worst case. CompileState::BudgetOf has the parts.
+  double budget_mm = 0;
+  double worst_case_mm = 0;
+  bool budget_bounded = true;  // false: the cell does not declare what would bound it
   bool is_placement() const;  // a Place statement
 };
 
@@ -150,15 +154,18 @@ struct CompileState {
   SharedText Share(std::string_view text);
   // One solver per region, made on first use (tables are validated at load).
   const InverseSolver& SolverFor(const cell::Region& region);
-  // The sensor's share of the position error at a fixture point (mm),
-  // through the fixture's estimator (calibration/fixture_estimation.h).
-  double SensorShareAt(const cell::Fixture& fixture, const Eigen::Vector2d& point_in_fixture);
+  // The fixture's scan as a source of placement error, made on first use.
+  const FixtureErrorModel& ErrorModelFor(const cell::Fixture& fixture) const;
+  // Every part of a known target's tolerance budget: static targets from
+  // their region, fixture targets also through their fixture's scan.
+  ErrorBudget BudgetOf(const Target& target) const;
 
  private:
   std::map<const cell::Region*, std::unique_ptr<InverseSolver>> solvers_;
   std::deque<std::string> shared_;  // deque: SharedText's pointers stay valid
   std::unordered_map<std::string_view, const std::string*> shared_by_text_;
-  std::map<const cell::Fixture*, std::unique_ptr<SensorShare>> sensor_shares_;
+  // A cache: the models depend only on the cell.
+  mutable std::map<const cell::Fixture*, std::unique_ptr<FixtureErrorModel>> error_models_;
 };
 
 // The base-frame position of a fixture-frame pose through FIX.

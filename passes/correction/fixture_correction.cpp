@@ -10,8 +10,8 @@
 // treats it like any off-line point (FIX_n · FIXPOS_0, the closed form of the
 // paper's Eq. 9). Every fixture target records its point in fixture
 // coordinates, the region whose table the runtime inverts (at the nominal
-// pose), that table's iteration bound, the command at the nominal pose (for
-// the report) and the sensor's share of its error.
+// pose), that table's iteration bound and the command at the nominal pose
+// (for the report).
 #include <map>
 #include <memory>
 
@@ -72,7 +72,6 @@ class FixtureCorrection final : public Pass {
         target.required = PoseToBase(binding.nominal, target.in_frame);
         target.region = cell.RegionAt(Xy(target.required));
       }
-      target.sensor_share_mm = state.SensorShareAt(*binding.cell_fixture, Xy(target.in_frame));
       if (target.region == nullptr) continue;  // reported by regions
       const InverseSolver& solver = state.SolverFor(*target.region);
       Solution solution = solver.Solve(Xy(target.required), target.region->outside);

@@ -2,7 +2,10 @@
 // (passes/correction/target_trace.h).
 #include "passes/correction/target_trace.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -11,8 +14,10 @@
 #include <unordered_map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "base/check.h"
+#include "calibration/limits.h"
 #include "ir/ir_ops.h"
 #include "ir/ir_text.h"
 #include "ir/ir_walk.h"
@@ -26,11 +31,36 @@ using Variables = std::map<std::string, Value>;
 // What a target's position depends on that is not known before run time.
 struct Unknown {
   std::string because;
+  bool reported = false;  // an error in the program, reported: no target
+};
+
+// The calls that led to the running statement, innermost first: a list
+// through the C++ stack (one node per active call), so entering a function
+// copies nothing; the text is made once per call, for the first target it reaches.
+struct CallPath {
+  const CallPath* caller = nullptr;
+  std::string_view function;
+  mutable std::optional<SharedText> shared = {};  // Text(), once a target needs it
+  // "Main > Layer > PlaceOne"; past `max_names` calls the middle is "...".
+  std::string Text(std::size_t max_names = SIZE_MAX) const {
+    std::vector<std::string_view> names;
+    for (const CallPath* at = this; at != nullptr; at = at->caller) names.push_back(at->function);
+    std::reverse(names.begin(), names.end());
+    if (names.size() > max_names && max_names >= 2) {
+      names.erase(names.begin() + static_cast<std::ptrdiff_t>(max_names / 2),
+                  names.end() - static_cast<std::ptrdiff_t>(max_names - max_names / 2 - 1));
+      names.insert(names.begin() + static_cast<std::ptrdiff_t>(max_names / 2), "...");
+    }
+    std::string text;
+    for (std::string_view name : names) text += (text.empty() ? "" : " > ") + std::string(name);
+    return text;
+  }
 };
 
 class Tracer {
  public:
-  Tracer(const sema::SymbolTable& symbols, CompileState& state) : symbols_(symbols), state_(state) {}
+  Tracer(const sema::SymbolTable& symbols, CompileState& state, Diagnostics& diags)
+      : symbols_(symbols), state_(state), diags_(diags) {}
 
   void Run() {
     for (const sema::Symbol& symbol : symbols_.symbols()) {
@@ -38,16 +68,17 @@ class Tracer {
     }
     const sema::Symbol* main = symbols_.Find("Main");
     if (main == nullptr || main->kind != sema::SymbolKind::Function) return;
-    Frame frame{&std::get<ir::Function>(main->decl->node), {}, "Main"};
+    const CallPath path{nullptr, "Main"};
+    Frame frame{&std::get<ir::Function>(main->decl->node), {}, &path};
     RunBlock(frame.function->body, frame);
-    state_.trace_complete = !out_of_steps_;
+    state_.trace_complete = !out_of_steps_;  // too deep is an error, reported
   }
 
  private:
   struct Frame {
     const ir::Function* function;
     Variables locals;
-    std::string call_path;
+    const CallPath* call_path;
   };
   enum class Flow { kNext, kExitFunction, kStop };
 
@@ -175,8 +206,11 @@ class Tracer {
                                           const ir::Stmt*& taught_decl) {
     Value number = Eval(pallet.number.get(), frame);
     if (!number) return Unknown{FirstUnknown(pallet.number.get(), frame)};
-    const sema::SymbolTable::PalletEntry* entry = symbols_.FindPallet(static_cast<int>(*number));
-    SMTCAL_CHECK(entry != nullptr, "a checked program uses only declared pallets");
+    const sema::SymbolTable::PalletEntry* entry = FindPallet(*number);
+    if (entry == nullptr) {
+      ReportUndeclaredPallet(pallet, *number, frame);
+      return Unknown{PrintExpr(*pallet.number), true};
+    }
     const ir::PalletDecl& decl = *entry->pallet;
     Value i = Eval(pallet.i.get(), frame);
     if (!i) return Unknown{FirstUnknown(pallet.i.get(), frame)};
@@ -208,15 +242,38 @@ class Tracer {
     return slot;
   }
 
+  // The pallet a number computed at compile time names, if it is declared.
+  // (The checks saw only the numbers written as constants.)
+  const sema::SymbolTable::PalletEntry* FindPallet(double number) const {
+    if (!(number >= limits::kPalletNumberMin && number <= limits::kPalletNumberMax) || number != std::floor(number)) {
+      return nullptr;
+    }
+    return symbols_.FindPallet(static_cast<int>(number));
+  }
+
+  void ReportUndeclaredPallet(const ir::PalletPoint& pallet, double number, const Frame& frame) {
+    if (!reported_pallets_.insert(pallet.number.get()).second) return;
+    std::vector<int> declared = symbols_.PalletNumbers();
+    std::string why =
+        number >= limits::kPalletNumberMin && number <= limits::kPalletNumberMax && number == std::floor(number)
+            ? fmt::format("no pallet {} is declared; {}", number,
+                          declared.empty() ? std::string("the program declares none")
+                                           : fmt::format("the declared pallets are {}", fmt::join(declared, ", ")))
+            : fmt::format("pallet numbers are whole numbers from {} to {}", limits::kPalletNumberMin,
+                          limits::kPalletNumberMax);
+    diags_.Report(DiagKind::TracePalletUndeclared, sema::ExprRange(*pallet.number), PrintExpr(*pallet.number),
+                  number, frame.call_path->Text(), why);
+  }
+
   void RecordTarget(const ir::Stmt& stmt, const ir::PointExpr& point, Frame& frame) {
     const ir::Stmt* taught_decl = nullptr;
     std::variant<RootedPose, Unknown> position = PointPosition(point, frame, taught_decl);
     Target target;
     target.stmt = &stmt;
     target.text = PrintPointExpr(point);
-    target.call_path = state_.Share(frame.call_path);
     target.taught_decl = taught_decl;
     if (auto* unknown = std::get_if<Unknown>(&position)) {
+      if (unknown->reported) return;
       target.known = false;
       target.unknown_because = state_.Share(unknown->because);
       // The frame is still known: the point's declaration decides it.
@@ -233,14 +290,14 @@ class Tracer {
     // A fixture the cell does not describe is reported by bind; its targets
     // have no frame to be corrected in.
     if (target.fixture < 0 && FixtureNamed(point, frame)) return;
-    std::size_t index = FindOrAddTarget(std::move(target));
+    std::size_t index = FindOrAddTarget(std::move(target), *frame.call_path);
     if (trace_ != nullptr && !exploring_) trace_->push_back({TraceEvent::Kind::kMotion, index, 0});
   }
 
   // Targets are unique per (statement, known, position). The targets of one
   // statement are chained (most statements have one), so the lookup costs a
   // hash of the statement and no node per target.
-  std::size_t FindOrAddTarget(Target target) {
+  std::size_t FindOrAddTarget(Target target, const CallPath& call_path) {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     next_of_stmt_.resize(state_.targets.size(), kNone);
     auto [first, inserted] = first_of_stmt_.emplace(target.stmt, state_.targets.size());
@@ -254,6 +311,9 @@ class Tracer {
       }
       next_of_stmt_[i] = state_.targets.size();
     }
+    // Where it was reached first: the text made once per call.
+    if (!call_path.shared) call_path.shared = state_.Share(call_path.Text());
+    target.call_path = *call_path.shared;
     state_.targets.push_back(std::move(target));
     next_of_stmt_.push_back(kNone);
     return state_.targets.size() - 1;
@@ -273,7 +333,7 @@ class Tracer {
     } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
       Value number = Eval(pallet->number.get(), frame);
       if (!number) return "";
-      const sema::SymbolTable::PalletEntry* entry = symbols_.FindPallet(static_cast<int>(*number));
+      const sema::SymbolTable::PalletEntry* entry = FindPallet(*number);
       if (entry == nullptr) return "";
       const auto& corner = std::get<ir::PointDecl>(symbols_.Find(entry->pallet->corners[0])->decl->node);
       if (corner.taught) return corner.frame;
@@ -289,13 +349,30 @@ class Tracer {
     return !out_of_steps_;
   }
 
+  // Every block entered (a body of a function, loop, branch or Cycle) is one
+  // level of the C++ stack; past kMaxTraceDepth the run stops, reported.
   Flow RunBlock(const ir::Block& block, Frame& frame) {
-    for (const ir::StmtPtr& stmt : block) {
-      if (!Step()) return Flow::kStop;
-      Flow flow = RunStmt(*stmt, frame);
-      if (flow != Flow::kNext) return flow;
+    if (depth_ >= kMaxTraceDepth) {
+      if (!too_deep_) {
+        too_deep_ = true;
+        const ir::Stmt* where = block.empty() ? nullptr : block.front().get();
+        diags_.Report(DiagKind::TraceTooDeep, where != nullptr ? sema::StmtRange(*where) : SourceRange{},
+                      kMaxTraceDepth, frame.call_path->Text(/*max_names=*/6));
+      }
+      return Flow::kStop;
     }
-    return Flow::kNext;
+    ++depth_;
+    Flow flow = Flow::kNext;
+    for (const ir::StmtPtr& stmt : block) {
+      if (!Step()) {
+        flow = Flow::kStop;
+        break;
+      }
+      flow = RunStmt(*stmt, frame);
+      if (flow != Flow::kNext) break;
+    }
+    --depth_;
+    return flow;
   }
 
   Flow RunStmt(const ir::Stmt& stmt, Frame& frame) {
@@ -318,7 +395,8 @@ class Tracer {
     } else if (const auto* call = std::get_if<ir::Call>(&stmt.node)) {
       const sema::Symbol* function = symbols_.Find(call->name);
       if (function == nullptr || function->kind != sema::SymbolKind::Function) return Flow::kNext;
-      Frame callee{&std::get<ir::Function>(function->decl->node), {}, frame.call_path + " > " + function->name};
+      const CallPath path{frame.call_path, function->name};
+      Frame callee{&std::get<ir::Function>(function->decl->node), {}, &path};
       Flow flow = RunBlock(callee.function->body, callee);
       return flow == Flow::kStop ? Flow::kStop : Flow::kNext;
     } else if (const auto* cycle = std::get_if<ir::Cycle>(&stmt.node)) {
@@ -431,6 +509,10 @@ class Tracer {
 
   const sema::SymbolTable& symbols_;
   CompileState& state_;
+  Diagnostics& diags_;
+  std::set<const ir::Expr*> reported_pallets_;
+  int depth_ = 0;  // blocks being run
+  bool too_deep_ = false;
   Variables globals_;
   std::unordered_map<const ir::Stmt*, std::size_t> first_of_stmt_;  // index into state_.targets
   std::vector<std::size_t> next_of_stmt_;  // per target: the next target of its statement
@@ -468,7 +550,8 @@ RootedPose ResolveFrame(const sema::SymbolTable& symbols, const std::string& fra
   return rooted;
 }
 
-void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, CompileState& state) {
+void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, CompileState& state,
+                  Diagnostics& diags) {
   // Room for one target per motion statement: most have one, and growing a
   // vector of a million targets would hold it twice for a moment.
   std::size_t motions = 0;
@@ -476,7 +559,7 @@ void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, 
     motions += std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node);
   });
   state.targets.reserve(state.targets.size() + motions);
-  Tracer(symbols, state).Run();
+  Tracer(symbols, state, diags).Run();
 }
 
 }  // namespace smtcal

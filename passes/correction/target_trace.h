@@ -17,7 +17,11 @@
 //
 // The run stops after kMaxTraceSteps statements (a loop over a million boards
 // needs no million-fold check; a 100 000-placement program takes about
-// 300 000); the caller reports that.
+// 300 000); the caller reports that. It also stops, reported here, where
+// blocks and calls nest more than kMaxTraceDepth deep (each is a level of
+// the C++ stack; real programs nest a few levels), and reports a pallet
+// number computed at compile time that names no declared pallet (the checks
+// see only constant numbers).
 #pragma once
 
 #include "base/diagnostics.h"
@@ -28,12 +32,14 @@
 namespace smtcal {
 
 inline constexpr long kMaxTraceSteps = 5'000'000;
+inline constexpr int kMaxTraceDepth = 1000;
 
 // Fills state.targets, state.cycle_traces and state.trace_complete. Expects a
 // program that passed the checks and state.fixtures bound. Taught points get
 // their taught (robot) coordinates as `in_frame` until fixture-correction
 // converts them.
-void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, CompileState& state);
+void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, CompileState& state,
+                  Diagnostics& diags);
 
 // The position of a point declared in `frame` (empty = base) at `local`, in
 // the frame's root: the fixture it hangs on (fixture_name set) or the base.

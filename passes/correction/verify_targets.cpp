@@ -14,6 +14,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -42,12 +43,14 @@ class VerifyTargets final : public Pass {
     SMTCAL_CHECK(program.compile != nullptr, "verify runs after bind");
     CompileState& state = *program.compile;
     const cell::Cell& cell = *state.cell;
+    std::set<int> unbounded_reported;
     for (Target& target : state.targets) {
       if (!target.known) continue;
       CheckLimits(target, cell.robot, diags);
+      CheckTravelHeight(target, cell.robot, diags);
       if (target.region == nullptr) continue;
       if (target.kind == CorrectionKind::kFixture) CheckFixtureMotion(target, state, diags);
-      CheckBudget(target, cell.robot, diags);
+      CheckBudget(target, state, unbounded_reported, diags);
     }
     EstimateCycles(state);
   }
@@ -110,16 +113,93 @@ class VerifyTargets final : public Pass {
                  FormatMm(fixture.max_shift_mm), FormatMm(fixture.max_rotation_deg));
   }
 
-  static void CheckBudget(Target& target, const cell::Robot& robot, Diagnostics& diags) {
-    if (target.kind == CorrectionKind::kUncorrected) return;
-    std::string_view keyword = TargetKeyword(*target.stmt);
-    target.budget_mm = target.residual_mm + robot.repeatability_mm + target.sensor_share_mm;
+  // A Pick or Place comes down from LimZ (or the cell's safe z) to its z: at
+  // or above that height the gripper never reaches the part.
+  static void CheckTravelHeight(const Target& target, const cell::Robot& robot, Diagnostics& diags) {
     if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) return;
+    const auto& pick_place = std::get<ir::PickPlace>(target.stmt->node);
+    const bool limz = pick_place.limz != nullptr;
+    if (limz && !sema::FoldConstant(pick_place.limz.get())) return;  // known only at run time
+    const double z = target.required[2];
+    const double from = LimZOf(*target.stmt, robot);
+    if (z < from) return;
+    const bool pick = pick_place.kind == ir::PickPlaceKind::Pick;
+    diags.Report(DiagKind::PickPlaceAtTravelHeight, Where(target), TargetKeyword(*target.stmt), target.text,
+                 FormatMm(z), limz ? fmt::format("its LimZ {}", FormatMm(from))
+                                   : fmt::format("the cell's safe_limz_mm = {}", FormatMm(from)),
+                 pick ? "the gripper would reach for the part" : "the part would be released",
+                 pick ? "pick" : "place", FormatMm(from));
+  }
+
+  static std::string BudgetParts(const ErrorBudget& budget) {
+    std::string text;
+    for (std::size_t k = 0; k < kErrorSources; ++k) {
+      const ErrorShare& share = budget.shares[k];
+      if (share.BudgetMm() == 0) continue;
+      text += fmt::format("{}{} {:.4f}", text.empty() ? "" : ", ", ErrorSourceName(static_cast<ErrorSource>(k)),
+                          share.BudgetMm());
+    }
+    return text;
+  }
+
+  // What to do about the largest part of a budget.
+  static std::string BudgetHint(ErrorSource largest, const Target& target, const CompileState& state) {
+    const cell::Fixture* fixture = target.fixture >= 0 ? state.fixtures[target.fixture].cell_fixture : nullptr;
+    switch (largest) {
+      case ErrorSource::kUncalibratedTrips:
+        return fmt::format("trips of fixture '{}' lie outside every calibrated table, so the robot's own error there "
+                           "moves the whole board: calibrate a region under its markers (docs/cell.md)",
+                           fixture != nullptr ? fixture->name : "");
+      case ErrorSource::kSensor:
+        if (fixture != nullptr && fixture->estimator == cell::Estimator::kPaper) {
+          return fmt::format("fixture '{}' uses estimator = \"paper\" (Eq. 4), which extrapolates each edge from "
+                             "two trips; estimator = \"rigid\" fits all trips at once (docs/periphery.md)",
+                             fixture->name);
+        }
+        return "a more accurate marker sensor, markers farther apart or more trips would shrink it";
+      case ErrorSource::kLatency:
+        return "lower the fixture's scan_speed_mm_s (or the controller's servo period, robot.servo_period_s)";
+      case ErrorSource::kScanRepeatability:
+      case ErrorSource::kRepeatability:
+        return "the robot's repeatability alone takes this much: the tolerance cannot be met with this robot";
+      case ErrorSource::kTable:
+      case ErrorSource::kTripTables:
+        return "measure the table with more repetitions (its node means are this uncertain)";
+      case ErrorSource::kResidual:
+        return "the inverse calibration did not converge here; check the table (smtcal table check)";
+    }
+    return "";
+  }
+
+  void CheckBudget(Target& target, const CompileState& state, std::set<int>& unbounded_reported,
+                   Diagnostics& diags) {
+    if (target.kind == CorrectionKind::kUncorrected) return;
+    const ErrorBudget budget = state.BudgetOf(target);
+    const ErrorShare total = budget.Total();
+    target.budget_bounded = budget.bounded;
+    target.budget_mm = total.BudgetMm();
+    target.worst_case_mm = total.worst_mm;
+    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) return;
+    if (!budget.bounded) {
+      if (!unbounded_reported.insert(target.fixture).second) return;
+      const FixtureBinding& binding = state.fixtures[target.fixture];
+      const FixtureErrorModel& model = state.ErrorModelFor(*binding.cell_fixture);
+      std::string trips;
+      for (std::size_t k : model.UncalibratedTrips()) trips += (trips.empty() ? "" : ", ") + TripName(k);
+      diags.Report(DiagKind::FixtureBudgetUnbounded, sema::StmtRange(*binding.decl), binding.name,
+                   model.defined() ? trips : std::string("(the nominal trips define no pose)"));
+      return;
+    }
     if (target.budget_mm <= target.region->tolerance_mm) return;
-    diags.Report(DiagKind::BudgetOverTolerance, Where(target), keyword, target.text,
-                 fmt::format("{:.4f}", target.budget_mm), fmt::format("{:.1e}", target.residual_mm),
-                 FormatMm(robot.repeatability_mm), fmt::format("{:.4f}", target.sensor_share_mm), target.region->name,
-                 FormatMm(target.region->tolerance_mm));
+    const ErrorSource largest = budget.Largest();
+    Diagnostic* diag = diags.Report(DiagKind::BudgetOverTolerance, Where(target), TargetKeyword(*target.stmt),
+                                    target.text, fmt::format("{:.4f}", target.budget_mm),
+                                    FormatMm(target.region->tolerance_mm), target.region->name,
+                                    ErrorSourceDescription(largest),
+                                    fmt::format("{:.4f}", budget[largest].BudgetMm()),
+                                    BudgetHint(largest, target, state));
+    Diagnostics::AddNote(diag, Where(target), fmt::format("the budget's parts, each alone at 4 sigma (mm): {}",
+                                                          BudgetParts(budget)));
   }
 
   // ---------------------------------------------------------------- cycle time

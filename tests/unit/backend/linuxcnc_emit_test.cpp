@@ -85,12 +85,14 @@ std::string ProbeReplacement(const std::vector<std::vector<Eigen::Vector2d>>& tr
   return out + "o<smtcal_probe_trips> endsub\n";
 }
 
-// Every fixture of the cell at a pose (nullopt: its nominal pose).
+// The trips every fixture of the cell records with its board at a pose
+// (nullopt: its nominal pose): where the robot is commanded when it really
+// is at the edge, as the cell's tables say (the runtime calibrates them back).
 std::vector<std::vector<Eigen::Vector2d>> TripsAt(const cell::Cell& cell,
                                                   const std::optional<Eigen::Affine3d>& pose = std::nullopt) {
   std::vector<std::vector<Eigen::Vector2d>> trips;
   for (const cell::Fixture& fixture : cell.fixtures) {
-    trips.push_back(NominalTrips(fixture, pose ? *pose : NominalFix(fixture)));
+    trips.push_back(CommandedTrips(fixture, cell.regions, pose ? *pose : NominalFix(fixture)));
   }
   return trips;
 }
@@ -283,6 +285,34 @@ TEST(LinuxCncEmit, ExampleWithTheRealProbeAbortsBeforeTheFirstPlacement) {
   fs::remove_all(dir);
 }
 
+// --dry-run-probe: OUTDIR/dry-run/ first on rs274's path runs the whole
+// example (100 boards) with the nominal trips, says so at every scan, moves
+// no probe; compiling again replaces the output with its dry-run folder.
+TEST(LinuxCncEmit, DryRunProbeFileRunsTheWholeExampleInRs274) {
+  ASSERT_TRUE(test::HaveRs274()) << "rs274 is not installed: install linuxcnc-uspace (tools/install-deps.sh)";
+  fs::path dir = Scratch("dryrun");
+  const std::string compile = fmt::format("compile {} --cell {} --target linuxcnc -o {} --dry-run-probe",
+                                          Quote(kExample), Quote(kCell), Quote(dir / "out"));
+  test::SmtcalRun compiled = test::RunSmtcal(compile);
+  ASSERT_EQ(compiled.exit_code, 0) << compiled.err;
+  const std::string probe = test::ReadFileText(dir / "out" / "dry-run" / "smtcal_probe_trips.ngc");
+  EXPECT_TRUE(probe.starts_with("; smtcal_probe_trips.ngc - DRY RUN ONLY")) << probe;
+  fs::path ini = test::WriteRs274Ini(dir / "ini", {dir / "out" / "dry-run", dir / "out" / "subroutines"});
+  test::Rs274Result run = test::RunRs274(ini, dir / "out" / "layers.ngc");
+  EXPECT_TRUE(RanToTheEnd(run)) << "exit " << run.exit_code << "\n" << run.err << Tail(run.out);
+  const auto said = std::count(run.messages.begin(), run.messages.end(),
+                               "smtcal dry run: fixture Board gets the nominal trips of its nominal pose; no scan");
+  EXPECT_EQ(said, 100) << "one message per scan";
+  for (const test::CanonMove& move : run.moves) ASSERT_NE(move.kind, "STRAIGHT_PROBE");
+  test::SmtcalRun again = test::RunSmtcal(compile);
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+  test::SmtcalRun wrong_target = test::RunSmtcal(
+      fmt::format("compile {} --cell {} -o {} --dry-run-probe", Quote(kExample), Quote(kCell), Quote(dir / "x.place")));
+  EXPECT_EQ(wrong_target.exit_code, 2) << wrong_target.err;
+  EXPECT_FALSE(fs::exists(dir / "x.place"));
+  fs::remove_all(dir);
+}
+
 // The shipped configuration (examples/linuxcnc/) finds the compiled
 // subroutines through its relative SUBROUTINE_PATH when run from its folder.
 TEST(LinuxCncEmit, ShippedExampleConfigurationFindsTheSubroutines) {
@@ -301,7 +331,7 @@ TEST(LinuxCncEmit, ShippedExampleConfigurationFindsTheSubroutines) {
   // The probe never trips in rs274: the scan's abort shows that smtcal_data,
   // smtcal_scan and its subroutines were all found.
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << err;
-  EXPECT_NE(err.find("smtcal: marker scan of fixture 0 failed check missing_trip"), std::string::npos) << err;
+  EXPECT_NE(err.find("smtcal: marker scan of fixture Board failed check missing_trip"), std::string::npos) << err;
   fs::remove_all(dir);
 }
 
@@ -330,7 +360,10 @@ TEST(LinuxCncEmit, OutputDirectoryHoldsTheProgramTheRuntimeAndTheData) {
   test::SmtcalRun review = test::RunSmtcal(
       fmt::format("compile {} --cell {} --target linuxcnc -o -", Quote(kExample), Quote(kCell)));
   ASSERT_EQ(review.exit_code, 0) << review.err;
-  EXPECT_EQ(review.out, "(smtcal file: layers.ngc)\n" + main + "(smtcal file: subroutines/smtcal_data.ngc)\n" + data);
+  const std::string aborts = test::ReadFileText(dir / "out" / "subroutines" / "smtcal_scan_abort.ngc");
+  EXPECT_NE(aborts.find("(abort,smtcal: marker scan of fixture Board failed check missing_trip: "), std::string::npos);
+  EXPECT_EQ(review.out, "(smtcal file: layers.ngc)\n" + main + "(smtcal file: subroutines/smtcal_data.ngc)\n" + data +
+                            "(smtcal file: subroutines/smtcal_scan_abort.ngc)\n" + aborts);
   fs::remove_all(dir);
 }
 
@@ -379,7 +412,7 @@ TEST(LinuxCncEmit, CommentsHoldNoParenthesesOrCommas) {
     ASSERT_TRUE(comment.ends_with(")")) << line;
     comment.pop_back();
     EXPECT_EQ(comment.find_first_of("()"), std::string::npos) << line;
-    if (comment.starts_with("abort, ")) comment = comment.substr(7);
+    if (comment.starts_with("abort,")) comment = comment.substr(6);
     EXPECT_EQ(comment.find(','), std::string::npos) << line;
     if (!subroutine && open > 0 && first < open) {
       ++blocks;

@@ -25,6 +25,7 @@
 
 #include "backend/linuxcnc/embedded_files.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/diagnostics.h"
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
@@ -67,6 +68,7 @@ struct Workspace {
       std::ofstream(sub / file.name, std::ios::binary) << file.text;
     }
     std::ofstream(sub / "smtcal_data.ngc", std::ios::binary) << EmitLinuxCncData(cell);
+    std::ofstream(sub / "smtcal_scan_abort.ngc", std::ios::binary) << EmitLinuxCncScanAbort(cell);
     std::vector<fs::path> path;
     if (with_override_dir) {
       fs::create_directories(dir / "first");
@@ -229,6 +231,7 @@ TEST(LinuxCncData, EveryRuntimeFileHoldsTheSubroutineOfItsName) {
     EXPECT_EQ(names.count(call), 1u) << call;
   }
   EXPECT_EQ(names.count("smtcal_data"), 0u) << "generated per cell, not a runtime file";
+  EXPECT_EQ(names.count("smtcal_scan_abort"), 0u) << "generated per cell, not a runtime file";
 }
 
 TEST(LinuxCncData, NumbersArePlainDecimalsThatReadBackExactly) {
@@ -563,7 +566,7 @@ TEST(LinuxCncRuntime, ExampleCellDataLoadsAndNominalTripsGiveTheNominalPose) {
   const Workspace ws("example", *cell, /*with_override_dir=*/true);
   const cell::Fixture& fixture = cell->fixtures[0];
   const Eigen::Affine3d nominal = NominalFix(fixture);
-  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(NominalTrips(fixture, nominal)));
+  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(CommandedTrips(fixture, cell->regions, nominal)));
   ws.Write("sub/smtcal_test_report.ngc", kReportSub);
   ws.Write("sub/smtcal_test_point.ngc", kPointSub);
   // A layer point on the board and a feeder position in the base frame.
@@ -608,15 +611,17 @@ TEST(LinuxCncRuntime, SecondScanIsCheckedAgainstTheFirstAndAbortsBeforePlacing) 
   ASSERT_TRUE(cell) << diagnostics;
   const Workspace ws("cycle", *cell, /*with_override_dir=*/true);
   const cell::Fixture& fixture = cell->fixtures[0];
-  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(NominalTrips(fixture, NominalFix(fixture))));
+  ws.Write("first/smtcal_probe_trips.ngc", ReplacementProbe(CommandedTrips(fixture, cell->regions, NominalFix(fixture))));
   // 1.5 mm and then -1 mm from nominal: each within max_shift_mm = 2 of
-  // nominal, but 2.5 mm from each other.
+  // nominal, but 2.5 mm from each other (commanded: the trips are
+  // direct-calibrated through the marker tables, whose slope makes the real
+  // move 2.4992 mm).
   const test::Rs274Result run = ws.Run(ProgramStart() +
                                        "#<_t_dx> = 1.5\no<smtcal_scan> call [0]\nM64 P7\n"
                                        "#<_t_dx> = -1\no<smtcal_scan> call [0]\nM64 P8\n" +
                                        ProgramEnd());
   EXPECT_EQ(run.exit_code, 1) << run.out;
-  EXPECT_NE(run.err.find("smtcal: marker scan of fixture 0 failed check cycle_shift: the origin moved 2.5000 mm "
+  EXPECT_NE(run.err.find("smtcal: marker scan of fixture Board failed check cycle_shift: the origin moved 2.4992 mm "
                          "since the last scan, limit max_shift_mm 2.0000"),
             std::string::npos)
       << run.err;
@@ -633,10 +638,10 @@ TEST(LinuxCncRuntime, BadScanAbortsBeforeTheFirstPlacement) {
   // The real probe file: rs274's probe never trips.
   const test::Rs274Result run = ws.Run(ProgramStart() + "F600\no<smtcal_scan> call [0]\nM64 P8\n" + ProgramEnd());
   EXPECT_EQ(run.exit_code, 1) << run.out;
-  EXPECT_NE(run.err.find("smtcal: marker scan of fixture 0 failed check missing_trip: 8 trips missing, the first T1, "
-                         "limit 0"),
+  EXPECT_NE(run.err.find("\nsmtcal: marker scan of fixture Board failed check missing_trip: 8 trips missing, the first "
+                         "T1, limit 0\n"),
             std::string::npos)
-      << run.err;
+      << "the message on a line of its own, no leading space: " << run.err;
   for (const std::string& line : run.canon) EXPECT_EQ(line.find("SET_AUX_OUTPUT_BIT"), std::string::npos) << line;
   // The scan: the first probe of each path toward its first leg's end at the
   // scan z, entering a marker (G38.3 prints no direction; its target is the
@@ -754,7 +759,7 @@ TEST(LinuxCncRuntime, FailedChecksAbortWithTheCheckItsValueAndLimit) {
         ws.Run(ProgramStart() + SetTrips(kHarnessFixture, c.trips) + SetPrevious(kHarnessFixture, c.previous) +
                fmt::format("o<smtcal_estimate> call [{}]\nM64 P8\n", kHarnessFixture) + ProgramEnd());
     EXPECT_EQ(run.exit_code, 1);
-    const std::string head = fmt::format("smtcal: marker scan of fixture {} failed check {}: ", kHarnessFixture, name);
+    const std::string head = fmt::format("smtcal: marker scan of fixture {} failed check {}: ", fixture.name, name);
     const std::size_t at = run.err.find(head);
     ASSERT_NE(at, std::string::npos) << run.err;
     const std::string message = run.err.substr(at, run.err.find('\n', at) - at);

@@ -12,6 +12,7 @@
 
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_estimation.h"
+#include "calibration/placement_budget.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
 namespace smtcal {
@@ -371,54 +372,82 @@ TEST(FixtureCorrections, CorrectedPointLandsWhereThePartMustGo) {
   EXPECT_EQ(outside.command, outside.required);
 }
 
-// --- the sensor's share --------------------------------------------------------------
+// --- the scan's share of the error budget (calibration/placement_budget.h) ---------
 
-TEST(FixtureSensorShare, MatchesTheSpreadOfSimulatedScans) {
+// A cell around one fixture, no tables: the budget's scan parts alone.
+cell::Cell CellOf(const cell::Fixture& fixture) {
+  cell::Cell cell;
+  cell.robot.repeatability_mm = 0.005;
+  cell.fixtures.push_back(fixture);
+  return cell;
+}
+
+TEST(FixtureErrorBudget, SensorPartMatchesTheSpreadOfSimulatedScans) {
   // Linear propagation against a Monte Carlo of the same model: each trip
-  // uniform in +-a across its edge has the standard deviation a / sqrt(3),
-  // so the share (a times the root sum of squares) is sqrt(3) standard
-  // deviations of the position error.
+  // uniform in +-a across its edge, a small enough for the linear regime.
   const std::uint64_t seed = test::FixtureSeed();
   SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
   std::mt19937_64 rng(seed);
   for (cell::Estimator estimator : kEstimators) {
     SCOPED_TRACE(std::string(cell::EstimatorName(estimator)));
-    const cell::Fixture fixture = PaperFixture(estimator);
-    const SensorShare share(fixture);
+    const cell::Cell cell = CellOf(PaperFixture(estimator));
+    const cell::Fixture& fixture = cell.fixtures.front();
+    const FixtureErrorModel model(cell, fixture);
+    ASSERT_TRUE(model.defined());
     const Eigen::Vector2d point(120, 60);
     const Eigen::Affine3d nominal = NominalFix(fixture);
     double sum = 0;
     const int scans = 4000;
+    const double a = 1e-3;
     for (int i = 0; i < scans; ++i) {
       std::vector<double> sensor;
-      for (int k = 0; k < 8; ++k) sensor.push_back(Uniform(rng, -1e-3, 1e-3));  // small: the linear regime
+      for (int k = 0; k < 8; ++k) sensor.push_back(Uniform(rng, -a, a));
       auto estimate = EstimateFix(fixture, ExpectedTrips(fixture), SimulateTrips(fixture, nominal, sensor), estimator);
       ASSERT_TRUE(estimate);
       sum += (ToBase(estimate->fix, point) - ToBase(nominal, point)).squaredNorm();
     }
-    const double sigma = std::sqrt(sum / scans);
-    const double predicted = share.AtMm(point) / fixture.sensor_accuracy_mm * 1e-3 / std::sqrt(3.0);
-    EXPECT_NEAR(sigma / predicted, 1, 0.06);
-    EXPECT_DOUBLE_EQ(SensorShareMm(fixture, point), share.AtMm(point));
+    const double measured = std::sqrt(sum / scans);
+    // The model's covariance is for +-sensor_accuracy_mm; scale it to +-a.
+    const Eigen::Matrix2d covariance = model.At(point, nullptr, 0)[ErrorSource::kSensor].covariance_mm2;
+    const double predicted = std::sqrt(covariance.trace()) * a / fixture.sensor_accuracy_mm;
+    EXPECT_NEAR(measured / predicted, 1, 0.06);
   }
 }
 
-TEST(FixtureSensorShare, LeastSquaresShareIsFarBelowEq4s) {
+TEST(FixtureErrorBudget, LeastSquaresSensorPartIsFarBelowEq4s) {
   const Eigen::Vector2d layer(120, 45);
-  const double paper = SensorShareMm(PaperFixture(cell::Estimator::kPaper), layer);
-  const double rigid = SensorShareMm(PaperFixture(cell::Estimator::kRigid), layer);
-  const double scaled = SensorShareMm(PaperFixture(cell::Estimator::kRigidScale), layer);
+  auto sensor = [&](cell::Estimator estimator) {
+    const cell::Cell cell = CellOf(PaperFixture(estimator));
+    return FixtureErrorModel(cell, cell.fixtures.front()).At(layer, nullptr, 0)[ErrorSource::kSensor].BudgetMm();
+  };
+  const double paper = sensor(cell::Estimator::kPaper), rigid = sensor(cell::Estimator::kRigid),
+               scaled = sensor(cell::Estimator::kRigidScale);
   EXPECT_LT(rigid, paper / 10);
   EXPECT_LE(rigid, scaled * (1 + 1e-6));
   EXPECT_GT(rigid, 0);
-  RecordProperty("share_mm", fmt::format("paper {:.4f} rigid {:.4f} rigid-scale {:.4f}", paper, rigid, scaled));
+  RecordProperty("sensor_part_mm", fmt::format("paper {:.4f} rigid {:.4f} rigid-scale {:.4f}", paper, rigid, scaled));
 }
 
-TEST(FixtureSensorShare, InfiniteWhenTheNominalTripsDefineNoPose) {
+TEST(FixtureErrorBudget, UnboundedWhenTheNominalTripsDefineNoPose) {
   cell::Fixture fixture = PaperFixture();
   fixture.edges[2] = {"p3", {182, 90}, {190, 90}, {}};  // p3 parallel to p1: S2 undefined
   fixture.edges[3] = {"p4", {190, 82}, {190, 90}, {}};
-  EXPECT_TRUE(std::isinf(SensorShareMm(fixture, Eigen::Vector2d(10, 10))));
+  const cell::Cell cell = CellOf(fixture);
+  const FixtureErrorModel model(cell, cell.fixtures.front());
+  EXPECT_FALSE(model.defined());
+  EXPECT_FALSE(model.At(Eigen::Vector2d(10, 10), nullptr, 0).bounded);
+  EXPECT_TRUE(std::isinf(model.At(Eigen::Vector2d(10, 10), nullptr, 0).BudgetMm()));
+}
+
+TEST(FixtureErrorBudget, UncalibratedTripsNeedTheRobotsDeclaredAccuracy) {
+  cell::Cell cell = CellOf(PaperFixture(cell::Estimator::kRigid));
+  const Eigen::Vector2d point(120, 45);
+  EXPECT_FALSE(FixtureErrorModel(cell, cell.fixtures.front()).At(point, nullptr, 0).bounded);
+  cell.robot.uncalibrated_accuracy_mm = 0.25;
+  const ErrorBudget budget = FixtureErrorModel(cell, cell.fixtures.front()).At(point, nullptr, 0);
+  ASSERT_TRUE(budget.bounded);
+  EXPECT_EQ(budget.Largest(), ErrorSource::kUncalibratedTrips);
+  EXPECT_GT(budget[ErrorSource::kUncalibratedTrips].bound_mm, 0.25);  // a rotation error grows with the arm
 }
 
 }  // namespace

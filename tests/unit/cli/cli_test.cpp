@@ -1,6 +1,10 @@
 // The driver's contract: exit codes, --help on every subcommand, --version,
 // and atomic outputs. Runs the real smtcal executable.
+#include <filesystem>
 #include <string>
+#include <vector>
+
+#include <unistd.h>
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
@@ -46,6 +50,42 @@ TEST(Cli, UnreadableInputExitsWithThree) {
   EXPECT_EQ(missing.exit_code, 3);
   EXPECT_NE(missing.err.find("cannot open '/nonexistent/dir/x.place'"), std::string::npos)
       << missing.err;
+}
+
+// An output that names one of the command's own inputs is refused (exit 2)
+// before anything is read, and the input is left as it was.
+TEST(Cli, OutputThatWouldOverwriteAnInputIsRefused) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / fmt::format("smtcal_cli_overwrite_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path example = fs::path(SMTCAL_SOURCE_DIR) / "examples" / "paper-cell";
+  for (const char* name : {"layers.place", "placing-table.csv"}) fs::copy_file(example / name, dir / name);
+  const std::string program = smtcal::test::ReadFileText(dir / "layers.place");
+  const std::string table = smtcal::test::ReadFileText(dir / "placing-table.csv");
+  const std::string cell = (example / "paper.cell.toml").string();
+  struct Case {
+    std::string args;
+    const char* output;
+  };
+  const std::vector<Case> cases = {
+      {fmt::format("compile layers.place --cell {} -o layers.place", cell), "layers.place"},
+      {fmt::format("compile layers.place --cell {} -o out.place --report layers.place", cell), "layers.place"},
+      {fmt::format("compile layers.place --cell {} --target linuxcnc -o .", cell), "."},
+      {"fmt layers.place -o layers.place", "layers.place"},
+      {"table build placing-table.csv -o placing-table.csv", "placing-table.csv"},
+      {"table plot placing-table.csv -o placing-table.csv", "placing-table.csv"},
+      {fmt::format("simulate layers.place --cell {} --cycles 1 --svg layers.place", cell), "layers.place"},
+      {"diff layers.place layers.place --svg layers.place", "layers.place"},
+  };
+  for (const Case& c : cases) {
+    SmtcalRun run = smtcal::test::RunSmtcal(c.args, dir);
+    EXPECT_EQ(run.exit_code, 2) << c.args << "\n" << run.err;
+    EXPECT_NE(run.err.find("would overwrite the input"), std::string::npos) << c.args << "\n" << run.err;
+  }
+  EXPECT_EQ(smtcal::test::ReadFileText(dir / "layers.place"), program);
+  EXPECT_EQ(smtcal::test::ReadFileText(dir / "placing-table.csv"), table);
+  fs::remove_all(dir);
 }
 
 }  // namespace

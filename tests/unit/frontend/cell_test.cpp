@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "calibration/fixture_geometry.h"
+#include "calibration/placement_budget.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
 #include "ir/ir.h"
@@ -181,9 +182,12 @@ TEST(PaperCellFile, LoadsWithoutAnyDiagnostic) {
   EXPECT_EQ(cell.robot.limits[3].lo, -360);
   EXPECT_EQ(cell.robot.repeatability_mm, 0.005);
 
-  ASSERT_EQ(cell.regions.size(), 4u);
-  const char* names[] = {"layer1", "layer2", "layer3", "feeders"};
-  for (std::size_t i = 0; i < 4; ++i) {
+  EXPECT_EQ(cell.robot.uncalibrated_accuracy_mm, 0.25);
+  EXPECT_EQ(cell.robot.servo_period_s, 0.001);
+
+  ASSERT_EQ(cell.regions.size(), 6u);
+  const char* names[] = {"layer1", "layer2", "layer3", "feeders", "marker1", "marker2"};
+  for (std::size_t i = 0; i < 6; ++i) {
     const Region& region = cell.regions[i];
     EXPECT_EQ(region.name, names[i]);
     EXPECT_EQ(region.difficulty_level, 2);
@@ -198,6 +202,13 @@ TEST(PaperCellFile, LoadsWithoutAnyDiagnostic) {
     EXPECT_GE(region.domain.y1 - region.y_mm.hi, 0.2) << region.name;
   }
   EXPECT_EQ(cell.regions[0].table_path, "placing-table.csv");
+  // Every trip of the marker scan is direct-calibrated, whatever pose the
+  // checks let through: its whole window lies in a marker table.
+  ASSERT_EQ(cell.fixtures.size(), 1u);
+  for (int region : TripRegions(cell.fixtures[0], cell.regions)) {
+    ASSERT_GE(region, 0);
+    EXPECT_TRUE(cell.regions[static_cast<std::size_t>(region)].name.starts_with("marker"));
+  }
   EXPECT_DOUBLE_EQ(cell.regions[0].domain.x0, 150.004);
   EXPECT_DOUBLE_EQ(cell.regions[0].domain.y1, 109.997);
 

@@ -28,7 +28,10 @@ std::unique_ptr<Traced> Trace(const std::string& declarations, const std::string
   board.name = "Board";
   traced->state.fixtures.push_back(board);
   sema::SymbolTable symbols = sema::SymbolTable::Build(traced->parsed.program);
-  TraceTargets(traced->parsed.program, symbols, traced->state);
+  SourceManager sources;
+  Diagnostics diags(sources);
+  TraceTargets(traced->parsed.program, symbols, traced->state, diags);
+  EXPECT_FALSE(diags.has_errors());
   return traced;
 }
 

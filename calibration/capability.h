@@ -1,0 +1,65 @@
+// Process figures a placement cell's quality engineer asks for
+// (docs/compile.md and docs/simulate.md, "Process figures"): per axis the
+// mean and standard deviation of the placement error, the machine capability
+// Cmk = (T - |mean|) / (3 sigma) at the tolerance T, and the expected parts
+// per million outside the tolerance circle, assuming the error is normal
+// (a normal fitted to the sample, or the budget's normal model per target).
+// The placement industry's reference is +-50 um at 4 sigma: sigma <= 12.5 um
+// per axis and Cmk >= 1.33 at +-50 um.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace smtcal {
+
+inline constexpr double kReferenceToleranceMm = 0.050;
+inline constexpr double kReferenceCmk = 1.33;
+
+struct Capability {
+  long placements = 0;
+  double tolerance_mm = 0;                           // T: the smallest tolerance of the placements
+  Eigen::Vector2d mean_mm = Eigen::Vector2d::Zero();  // per axis
+  Eigen::Vector2d sigma_mm = Eigen::Vector2d::Zero();  // per axis
+  Eigen::Vector2d cmk = Eigen::Vector2d::Zero();       // per axis, at T
+  double ppm_outside = 0;      // expected, normal assumption
+  double reference_cmk = 0;    // the smaller axis Cmk at +-50 um
+  bool MeetsReference() const { return reference_cmk >= kReferenceCmk; }
+  double WorstCmk() const { return cmk.minCoeff(); }
+};
+
+// Cmk of one axis; +infinity for a spread of zero inside the tolerance.
+double Cmk(double tolerance_mm, double mean_mm, double sigma_mm);
+
+// From placement errors (sample vectors, where the part landed minus where it
+// belongs): the sample's mean and covariance, and a normal fitted to them.
+class SampleCapability {
+ public:
+  void Add(const Eigen::Vector2d& error_mm, double tolerance_mm);
+  Capability Result() const;
+
+ private:
+  long n_ = 0;
+  double tolerance_mm_ = 0;
+  Eigen::Vector2d sum_ = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_squares_ = Eigen::Matrix2d::Zero();
+};
+
+// From the budget's model of each placement: a known mean, an unknown
+// systematic part up to `bound_mm` (taken in its worst direction) and a
+// normal random part. The pooled mean and spread are those of the mixture;
+// the ppm is the mixture's.
+class ModelCapability {
+ public:
+  void Add(const Eigen::Vector2d& mean_mm, double bound_mm, const Eigen::Matrix2d& covariance_mm2,
+           double tolerance_mm);
+  Capability Result() const;
+
+ private:
+  long n_ = 0;
+  double tolerance_mm_ = 0;
+  Eigen::Vector2d sum_mean_ = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_second_ = Eigen::Matrix2d::Zero();  // E[e e^T] summed
+  double sum_outside_ = 0;
+};
+
+}  // namespace smtcal
