@@ -301,7 +301,7 @@ TEST(LinuxCncEmit, DryRunProbeFileRunsTheWholeExampleInRs274) {
   test::Rs274Result run = test::RunRs274(ini, dir / "out" / "layers.ngc");
   EXPECT_TRUE(RanToTheEnd(run)) << "exit " << run.exit_code << "\n" << run.err << Tail(run.out);
   const auto said = std::count(run.messages.begin(), run.messages.end(),
-                               "smtcal dry run: fixture Board gets the nominal trips of its nominal pose; no scan");
+                               "smtcal dry run: fixture Board gets the trips of its nominal pose; no scan");
   EXPECT_EQ(said, 100) << "one message per scan";
   for (const test::CanonMove& move : run.moves) ASSERT_NE(move.kind, "STRAIGHT_PROBE");
   test::SmtcalRun again = test::RunSmtcal(compile);

@@ -223,7 +223,7 @@ TEST_F(Environment, OutOfMemoryIsExitThreeNotAnInputError) {
   {
     std::ofstream big(Path("big.place"));
     big << "Program Big\nUnits mm\nVacuum 8\nPoint P = XY(200, 20, -10, 0)\n\nFunction Main\n";
-    for (int i = 0; i < 30000; ++i) big << "  Jump P + X(1) + Y(2) + Z(3)\n";  // checked in 200 MB
+    for (int i = 0; i < 300000; ++i) big << "  Jump P + X(1) + Y(2) + Z(3)\n";  // checked in about 290 MB
     big << "Fend\n";
   }
   // A valid program, in 150 MB of address space.

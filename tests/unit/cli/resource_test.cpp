@@ -58,12 +58,12 @@ TEST(Resources, RunningOutOfMemoryWhileParsingIsNotASyntaxError) {
   fs::path dir = Scratch("parse");
   std::ofstream(dir / "big.place") << bench::GeneratePlacements(300000);  // 30 MB, its IR alone 300 MB
   LimitedRun run = RunWithMemoryLimit(dir, 400000, "check big.place");
-  // Exit 3 where the driver reports resource failures, else the abort of an
-  // uncaught std::bad_alloc; never exit 1 with a diagnostic.
-  EXPECT_TRUE(run.exit_code == 3 || run.exit_code == -1 || run.exit_code == 134) << run.exit_code << run.err;
+  // Exit 3, the driver's report of resource failures; never exit 1 with a
+  // diagnostic.
+  EXPECT_EQ(run.exit_code, 3) << run.err;
   EXPECT_EQ(run.err.find("parser stopped"), std::string::npos) << run.err;
   EXPECT_EQ(run.err.find("big.place:"), std::string::npos) << "no diagnostic in the program: " << run.err;
-  EXPECT_NE(run.err.find("bad_alloc"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("smtcal: error: out of memory"), std::string::npos) << run.err;
   fs::remove_all(dir);
 }
 
