@@ -33,6 +33,7 @@ struct ImportCliOptions {
   std::string columns;
   std::string side;
   std::string mirror;
+  std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
   std::string origin = "0,0";
@@ -164,6 +165,8 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   if (opt.mirror == "none") import.mirror = ImportMirror::kNone;
   if (opt.mirror == "x") import.mirror = ImportMirror::kX;
   if (opt.mirror == "y") import.mirror = ImportMirror::kY;
+  if (opt.bottom_positions == "top-view") import.bottom_positions = cad::BottomPositions::kTopView;
+  if (opt.bottom_positions == "negated-x") import.bottom_positions = cad::BottomPositions::kNegatedX;
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
   std::array<double, 2> origin = *ParsePair(opt.origin), pitch = *ParsePair(opt.pitch);
@@ -304,6 +307,11 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
                   "the board coordinate that changes sign: none, x or y (default: none for the top side, x for\n"
                   "the bottom side, the board turned over about its y axis)")
       ->check(CLI::IsMember({"none", "x", "y"}));
+  cmd->add_option("--bottom-positions", opt.bottom_positions,
+                  "how the list gives bottom-side x: top-view (as seen from the top) or negated-x (as seen\n"
+                  "from the bottom: KiCad 6 and older, KiCad's 'negative X'); default: detected, and the\n"
+                  "summary says what was applied and why")
+      ->check(CLI::IsMember({"top-view", "negated-x"}));
   cmd->add_option("--bottom-rotation", opt.bottom_rotation,
                   "how the list gives bottom-side rotations: top-view (as seen through the board from the top,\n"
                   "mirrored with the positions) or bottom-view (as seen from below, kept)")

@@ -24,7 +24,7 @@ namespace smtcal::cad {
 namespace {
 
 // "Units used: mil" (possibly quoted, in the CSV report).
-bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<StatedUnit>& unit, Diagnostics& diags) {
+bool AltiumUnitLine(const Lines& lines, std::uint32_t number, Preamble& preamble, Diagnostics& diags) {
   std::string_view text = lines.Text(number);
   constexpr std::string_view kKey = "Units used:";
   std::size_t key = text.find(kKey);
@@ -40,7 +40,7 @@ bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<Stat
                  " in the report's 'Units used'");
     return false;
   }
-  unit = StatedUnit{*parsed, lines.Range(number, begin, word.size())};
+  preamble.unit = StatedUnit{*parsed, lines.Range(number, begin, word.size())};
   return true;
 }
 

@@ -44,6 +44,15 @@ struct ReadOptions {
   Side side_without_column = Side::kTop;  // the side of rows when the list has no side column
 };
 
+// What a list's preamble says about the tool that wrote it: KiCad's
+// "### Printed by Pcbnew version 6.0.11" (the bottom-side convention
+// depends on it, docs/import.md).
+struct ToolVersion {
+  std::string text;   // "6.0.11+dfsg-1" as written; empty when the list names none
+  int major = 0;      // 6; 0 when unknown
+  SourceRange range;  // where the list says so
+};
+
 class ListReader {
  public:
   virtual ~ListReader() = default;
@@ -56,6 +65,7 @@ class ListReader {
   LengthUnit unit() const { return unit_; }  // the list's length unit
   std::size_t rows_read() const { return rows_read_; }
   std::size_t rows_with_errors() const { return rows_with_errors_; }
+  const ToolVersion& tool_version() const { return tool_version_; }
 
  protected:
   explicit ListReader(Format format) : format_(format) {}
@@ -63,6 +73,7 @@ class ListReader {
   LengthUnit unit_ = LengthUnit::kMm;
   std::size_t rows_read_ = 0;
   std::size_t rows_with_errors_ = 0;
+  ToolVersion tool_version_;
 };
 
 // Opens the list registered as `file` in diags.sources(). Returns null after

@@ -40,6 +40,12 @@ double MmPer(LengthUnit unit);               // 1, 0.0254, 25.4
 enum class Side { kTop, kBottom };
 std::string_view SideName(Side side);  // top | bottom
 
+// How a list writes the x of its bottom-side parts: as seen from the top
+// through the board (most tools), or negated, as seen from the bottom
+// (KiCad 6 and older always; KiCad 7 and later when "negative X" is asked
+// for). Rotations are a separate matter (BottomRotation in cad_to_program.h).
+enum class BottomPositions { kTopView, kNegatedX };
+
 // Which column of a list a field plays; also the --columns keys.
 enum class Column { kDesignator, kValue, kPackage, kX, kY, kRotation, kSide, kDnp };
 inline constexpr int kColumnCount = 8;

@@ -90,6 +90,7 @@ class TableReader final : public ListReader {
       return false;
     }
     ReadUnits();
+    tool_version_ = preamble_.version;
     decimal_comma_ = delimiter_ != ',';
     next_line_ = header_line_ + 1;
     return true;
@@ -140,7 +141,7 @@ class TableReader final : public ListReader {
     std::vector<Field> fields;
     Diagnostics quiet(diags_.sources());  // lines before the header are not held to CSV rules
     for (std::uint32_t number = 1; number <= lines_.count(); ++number) {
-      if (dialect_.preamble != nullptr && !dialect_.preamble(lines_, number, stated_, diags_)) return false;
+      if (dialect_.preamble != nullptr && !dialect_.preamble(lines_, number, preamble_, diags_)) return false;
       if (dialect_.hash_header && SplitHashHeader(number, fields, quiet) && IsHeader(fields)) {
         return TakeHeader(number, ' ', fields);
       }
@@ -219,7 +220,7 @@ class TableReader final : public ListReader {
 
   // The list's own unit (preamble or column names) against --units.
   void ReadUnits() {
-    std::optional<StatedUnit> stated = stated_;
+    std::optional<StatedUnit> stated = preamble_.unit;
     for (int c : {static_cast<int>(Column::kX), static_cast<int>(Column::kY)}) {
       if (column_unit_[c] && !stated) stated = StatedUnit{*column_unit_[c], column_unit_range_[c]};
     }
@@ -340,7 +341,7 @@ class TableReader final : public ListReader {
   Dialect dialect_;
   ReadOptions options_;
   Diagnostics& diags_;
-  std::optional<StatedUnit> stated_;
+  Preamble preamble_;
   std::uint32_t header_line_ = 0;
   std::uint32_t next_line_ = 1;
   char delimiter_ = ',';

@@ -32,16 +32,21 @@ struct StatedUnit {
   SourceRange range;  // where the list says so
 };
 
+// What the preamble lines said: the unit, the tool's version.
+struct Preamble {
+  std::optional<StatedUnit> unit;
+  ToolVersion version;
+};
+
 struct Dialect {
   Format format = Format::kGenericCsv;
   std::vector<ColumnAlias> aliases;
   std::array<bool, kColumnCount> required{};  // columns a header must have
   bool hash_header = false;  // the header line starts with '#' (KiCad .pos)
   bool fixed_width = false;  // rows whose blank-separated fields do not fit are cut at the header's columns (Altium text)
-  // Reads a line before the header; may state the unit. Returns false after
-  // reporting a mistake.
-  bool (*preamble)(const Lines& lines, std::uint32_t number, std::optional<StatedUnit>& unit,
-                   Diagnostics& diags) = nullptr;
+  // Reads a line before the header; may state the unit or the tool's
+  // version. Returns false after reporting a mistake.
+  bool (*preamble)(const Lines& lines, std::uint32_t number, Preamble& preamble, Diagnostics& diags) = nullptr;
   // Generic CSV given by column numbers: no header, 0-based field index per
   // column (-1 = not mapped).
   std::optional<std::array<int, kColumnCount>> fixed_columns;

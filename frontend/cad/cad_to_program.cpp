@@ -21,6 +21,7 @@
 #include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
+#include "frontend/cad/cad_bottom.h"
 #include "frontend/cad/cad_text.h"
 
 namespace smtcal {
@@ -274,6 +275,7 @@ std::string FormatImportSummary(const ImportSummary& s) {
     reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", s.skipped[r], SkipReasonName(static_cast<SkipReason>(r)));
   }
   text += fmt::format("  skipped: {}{}\n", skipped, reasons.empty() ? "" : " (" + reasons + ")");
+  if (!s.bottom.empty()) text += fmt::format("  bottom:  {}\n", s.bottom);
   return text;
 }
 
@@ -438,7 +440,9 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
     summary_.failed = true;
     return std::nullopt;
   }
-  std::optional<ir::Program> program = Build(placed, side);
+  cad::BottomPositions bottom_positions = cad::BottomPositions::kTopView;
+  if (side == cad::Side::kBottom) bottom_positions = DescribeBottom(reader);
+  std::optional<ir::Program> program = Build(placed, side, bottom_positions);
   std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
   if (!program || diags_.has_errors()) {
     summary_.failed = true;
@@ -447,7 +451,41 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   return program;
 }
 
-std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side) {
+cad::BottomPositions CadImporter::DescribeBottom(const cad::ListReader& reader) {
+  cad::BottomPositions positions;
+  std::string why;
+  if (options_.bottom_positions) {
+    positions = *options_.bottom_positions;
+    why = "as --bottom-positions says";
+  } else {
+    std::vector<cad::SidedX> sided;
+    sided.reserve(parts_.size());
+    for (const Part& part : parts_) sided.push_back({part.x_mm, part.side});
+    cad::BottomDecision decision = cad::DecideBottomPositions(reader, sided);
+    positions = decision.positions;
+    why = decision.why;
+  }
+  const ImportMirror mirror = options_.mirror.value_or(ImportMirror::kX);
+  const bool negated = positions == cad::BottomPositions::kNegatedX;
+  const bool top_view_rotation = options_.bottom_rotation == BottomRotation::kTopView;
+  // The program's x, y and u from the list's, in the list's own numbers.
+  std::string x = (mirror == ImportMirror::kX) != negated ? "x' = -x" : "x' = x";
+  std::string y = mirror == ImportMirror::kY ? ", y' = -y" : "";
+  std::string u = mirror == ImportMirror::kNone || !top_view_rotation ? "u = rotation"
+                  : mirror == ImportMirror::kX                        ? "u = 180° - rotation"
+                                                                      : "u = -rotation";
+  summary_.bottom = fmt::format(
+      "x as seen from the {}: {}\n           rotations as seen from the {}; {}: {}{}, {}",
+      negated ? "bottom (negated)" : "top", why, top_view_rotation ? "top" : "bottom",
+      mirror == ImportMirror::kX   ? "the board turned over about its y axis"
+      : mirror == ImportMirror::kY ? "the board turned over about its x axis"
+                                   : "the board not turned over (--mirror none)",
+      x, y, u);
+  return positions;
+}
+
+std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side,
+                                              cad::BottomPositions bottom_positions) {
   const SourceLoc start{list_file_, 1, 1};
   const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
   NameTable names(parts.size() * static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows) +
@@ -542,9 +580,12 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   const ImportMirror mirror = options_.mirror.value_or(side == cad::Side::kBottom ? ImportMirror::kX : ImportMirror::kNone);
   const bool mirror_rotation =
       mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
-  std::string how = mirror == ImportMirror::kX   ? ", turned over: x negated"
-                    : mirror == ImportMirror::kY ? ", turned over: y negated"
-                                                 : "";
+  const bool list_negated = side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX;
+  std::string how = mirror == ImportMirror::kX   ? (list_negated ? ", turned over: x as the list writes it (negated there)"
+                                                                 : ", turned over: x negated")
+                    : mirror == ImportMirror::kY ? (list_negated ? ", turned over: y negated, the list's negated x undone"
+                                                                 : ", turned over: y negated")
+                                                 : (list_negated ? ", the list's negated x undone" : "");
   std::vector<std::string> comments;  // per part: " C1 100n C_0603"
   comments.reserve(parts.size());
   for (const Part* part : parts) comments.push_back(" " + PartComment(*part));
@@ -573,7 +614,10 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         }
       }
       point_name[b][i] = name;
-      double x = mirror == ImportMirror::kX ? -part.x_mm : part.x_mm;
+      // The list's x as seen from the top, then turned over.
+      const double x_top =
+          side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX ? -part.x_mm : part.x_mm;
+      double x = mirror == ImportMirror::kX ? -x_top : x_top;
       double y = mirror == ImportMirror::kY ? -part.y_mm : part.y_mm;
       double theta = part.rotation_deg;
       if (mirror_rotation) theta = mirror == ImportMirror::kX ? 180.0 - theta : -theta;

@@ -51,6 +51,8 @@ enum class AngleRange { kSigned, kPositive };
 struct ImportOptions {
   std::optional<cad::Side> side;  // nullopt: the only side the list has parts on
   std::optional<ImportMirror> mirror;  // nullopt: none for top, x for bottom
+  // nullopt: decided from the list (cad_bottom.h)
+  std::optional<cad::BottomPositions> bottom_positions;
   BottomRotation bottom_rotation = BottomRotation::kTopView;
   AngleRange angles = AngleRange::kSigned;
   double origin_x_mm = 0;  // the board origin in the fixture frame
@@ -84,6 +86,10 @@ struct ImportSummary {
   std::size_t feeders_used = 0;
   std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
   std::string format;  // "KiCad CSV, mm"
+  // How the bottom side was read, when it is placed: "x negated in the list
+  // (KiCad 6.0.11 writes them so (line 2)); rotations as seen from the top;
+  // turned over about the board's y axis".
+  std::string bottom;
   bool failed = false;  // errors stopped the import: nothing is placed
 };
 // "import: 12 rows read: 9 placed (x 4 boards = 36 placements, 3 feeders),
@@ -129,7 +135,10 @@ class CadImporter {
   std::optional<cad::FeederMatch> FindFeeder(const cad::Row& row);
   void ReportSkip(const Part& part, cad::Side placed_side);
   void ReportUnmapped(const std::vector<const Part*>& unmapped);
-  std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side);
+  // How the bottom side is read (option or cad_bottom.h); fills summary_.bottom.
+  cad::BottomPositions DescribeBottom(const cad::ListReader& reader);
+  std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side,
+                                   cad::BottomPositions bottom_positions);
 
   const cad::FeederTable& feeders_;
   ImportOptions options_;
