@@ -15,7 +15,7 @@
 # own exporter (PLACE_FILE_EXPORTER, the code behind File > Fabrication
 # Outputs > Component Placement):
 #   kicad6_bottom.pos        ASCII .pos, mm, bottom side, auxiliary origin
-#   kicad6_bottom.csv        CSV, mm, bottom side, auxiliary origin
+#   kicad6_csv_bottom.csv    CSV, mm, bottom side, auxiliary origin
 #   kicad6_bottom_inch.pos   ASCII .pos, inches, bottom side, auxiliary origin
 #   kicad6_top.pos           ASCII .pos, mm, top side, auxiliary origin
 #   kicad6_all_page.pos      ASCII .pos, mm, both sides, page origin
@@ -164,7 +164,7 @@ def main():
     os.makedirs(SUITE, exist_ok=True)
     board = make_board()
     export(board, "kicad6_bottom.pos", top=False)
-    export(board, "kicad6_bottom.csv", top=False, csv=True)
+    export(board, "kicad6_csv_bottom.csv", top=False, csv=True)
     export(board, "kicad6_bottom_inch.pos", mm=False, top=False)
     export(board, "kicad6_top.pos", bottom=False)
     export(board, "kicad6_all_page.pos", aux=False)

@@ -225,7 +225,7 @@ TEST(CadImport, KicadListsPlaceEveryPadWhereKicadPutIt) {
     double tolerance_mm;        // what the list's decimals allow
   };
   const std::vector<Case> cases = {
-      {"kicad6_bottom.pos", "bottom", 0, 0, 1e-4},      {"kicad6_bottom.csv", "bottom", 0, 0, 1e-4},
+      {"kicad6_bottom.pos", "bottom", 0, 0, 1e-4},      {"kicad6_csv_bottom.csv", "bottom", 0, 0, 1e-4},
       {"kicad6_bottom_inch.pos", "bottom", 0, 0, 2e-3}, {"kicad6_top.pos", "top", 0, 0, 1e-4},
       {"kicad6_all_page.pos", "bottom", -90, 140, 1e-4}, {"kicad8_bottom.pos", "bottom", 0, 0, 1e-4},
   };
