@@ -228,21 +228,25 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     options.exit_code = ReportIoError(list.error());
     return;
   }
-  std::unique_ptr<cad::ListReader> reader = cad::OpenList(list.value(), read, diags);
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;
+  std::optional<std::uint32_t> list_file = cad::DecodeList(list.value(), sources, diags, encoding);
+  std::unique_ptr<cad::ListReader> reader = list_file ? cad::OpenList(*list_file, read, diags) : nullptr;
   if (!feeders || !reader) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
 
   ImportOptions import = MakeImportOptions(opt, *fixture);
+  import.encoding = encoding;
   import.header_lines = {
-      fmt::format("Imported by smtcal import from {} ({}, {}).", BaseName(opt.list), cad::FormatTitle(reader->format()),
-                  cad::UnitName(reader->unit())),
+      fmt::format("Imported by smtcal import from {} ({}, {}{}).", BaseName(opt.list),
+                  cad::FormatTitle(reader->format()), cad::UnitName(reader->unit()),
+                  encoding == cad::TextEncoding::kUtf8 ? "" : fmt::format(", {} text", cad::EncodingName(encoding))),
       fmt::format("Cell {}, fixture {}{}.", BaseName(opt.cell), fixture->name,
                   opt.feeders.empty() ? "" : ", feeders " + BaseName(opt.feeders)),
       "To change it, change the list, the cell, the feeders or the options and import again.",
   };
-  CadImporter importer(*feeders, std::move(import), list.value(), diags);
+  CadImporter importer(*feeders, std::move(import), *list_file, diags);
   cad::Row row;
   while (reader->Next(row)) importer.Add(row);
   std::optional<ir::Program> program = importer.Finish(*reader);
@@ -271,7 +275,7 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
 
   // The list.
   cmd->add_option("--format", opt.format, "the list's format when detection is not wanted")
-      ->check(CLI::IsMember({"kicad-pos", "kicad-csv", "jlcpcb", "altium", "eagle", "diptrace", "csv"}));
+      ->check(CLI::IsMember(std::vector<std::string>(std::begin(cad::kFormatNames), std::end(cad::kFormatNames))));
   cmd->add_option("--columns", opt.columns,
                   "for --format csv: KEY=COLUMN,... with keys designator, x, y (needed) and rotation, value,\n"
                   "package, side, dnp; columns by header name or 1-based number (then there is no header)");

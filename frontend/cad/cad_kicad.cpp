@@ -33,20 +33,18 @@ namespace smtcal::cad {
 namespace {
 
 std::vector<ColumnAlias> KicadAliases() {
-  return {
-      {"ref", "Ref", Column::kDesignator, 0},  {"val", "Val", Column::kValue, 0},
-      {"package", "Package", Column::kPackage, 0}, {"posx", "PosX", Column::kX, 0},
-      {"posy", "PosY", Column::kY, 0},         {"rot", "Rot", Column::kRotation, 0},
-      {"side", "Side", Column::kSide, 0},      {"dnp", "DNP", Column::kDnp, 0},
-  };
+  return MakeAliases({{Column::kDesignator, {"Ref"}},
+                      {Column::kValue, {"Val"}},
+                      {Column::kPackage, {"Package"}},
+                      {Column::kX, {"PosX"}},
+                      {Column::kY, {"PosY"}},
+                      {Column::kRotation, {"Rot"}},
+                      {Column::kSide, {"Side"}},
+                      {Column::kDnp, {"DNP"}}});
 }
 
 std::array<bool, kColumnCount> KicadRequired() {
-  std::array<bool, kColumnCount> required{};
-  for (Column c : {Column::kDesignator, Column::kX, Column::kY, Column::kRotation}) {
-    required[static_cast<int>(c)] = true;
-  }
-  return required;
+  return RequiredColumns({Column::kDesignator, Column::kX, Column::kY, Column::kRotation});
 }
 
 // "### Printed by Pcbnew version 6.0.11+dfsg-1", "### Printed by KiCad

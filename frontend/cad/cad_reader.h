@@ -20,6 +20,7 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "frontend/cad/cad_encoding.h"
 #include "frontend/cad/cad_row.h"
 
 namespace smtcal::cad {
@@ -75,6 +76,12 @@ class ListReader {
   std::size_t rows_with_errors_ = 0;
   ToolVersion tool_version_;
 };
+
+// Decodes the list registered as `file` to UTF-8 (cad_encoding.h): the id
+// of the decoded text (`file` itself when it is UTF-8 already), or nullopt
+// after reporting why it cannot be decoded. `encoding` tells which it was.
+std::optional<std::uint32_t> DecodeList(std::uint32_t file, SourceManager& sources, Diagnostics& diags,
+                                        TextEncoding& encoding);
 
 // Opens the list registered as `file` in diags.sources(). Returns null after
 // reporting why when the list cannot be read at all (unknown format, no

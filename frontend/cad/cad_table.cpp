@@ -357,6 +357,28 @@ class TableReader final : public ListReader {
 
 }  // namespace
 
+std::vector<ColumnAlias> MakeAliases(std::initializer_list<ColumnNames> names) {
+  std::vector<ColumnAlias> aliases;
+  for (const ColumnNames& column : names) {
+    for (std::size_t rank = 0; rank < column.ranked.size(); ++rank) {
+      std::string_view equal = column.ranked[rank];
+      while (!equal.empty()) {
+        std::size_t bar = std::min(equal.find('|'), equal.size());
+        std::string_view display = equal.substr(0, bar);
+        aliases.push_back({NormaliseColumnName(display).base, std::string(display), column.column, static_cast<int>(rank)});
+        equal.remove_prefix(std::min(bar + 1, equal.size()));
+      }
+    }
+  }
+  return aliases;
+}
+
+std::array<bool, kColumnCount> RequiredColumns(std::initializer_list<Column> columns) {
+  std::array<bool, kColumnCount> required{};
+  for (Column c : columns) required[static_cast<int>(c)] = true;
+  return required;
+}
+
 bool MentionsColumn(const std::vector<Field>& fields, const std::vector<ColumnAlias>& aliases, Column column) {
   for (const Field& field : fields) {
     const ColumnAlias* alias = FindAlias(aliases, NormaliseColumnName(field.text).base);

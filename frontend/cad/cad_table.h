@@ -26,6 +26,17 @@ struct ColumnAlias {
   int rank = 0;  // when a header has two names for one column, the lower rank wins
 };
 
+// The names a column goes by in one family, best first: each entry is one
+// name or several of equal rank separated by '|' ("Center-X|Mid X"); a
+// later entry is used only when the header has none of the earlier ones.
+struct ColumnNames {
+  Column column;
+  std::vector<std::string_view> ranked;
+};
+std::vector<ColumnAlias> MakeAliases(std::initializer_list<ColumnNames> names);
+// The columns a header must have.
+std::array<bool, kColumnCount> RequiredColumns(std::initializer_list<Column> columns);
+
 // What a preamble line said about the list's unit.
 struct StatedUnit {
   LengthUnit unit = LengthUnit::kMm;
@@ -63,6 +74,7 @@ Dialect KicadPosDialect();
 Dialect KicadCsvDialect();
 Dialect AltiumDialect();
 Dialect JlcpcbDialect();
+Dialect EasyEdaDialect();
 Dialect DipTraceDialect();
 Dialect GenericDialect(const ColumnMapping& mapping);
 

@@ -455,6 +455,7 @@ std::string_view FormatTitle(Format format) {
     case Format::kKicadPos: return "KiCad .pos";
     case Format::kKicadCsv: return "KiCad CSV";
     case Format::kJlcpcb: return "JLCPCB CPL";
+    case Format::kEasyEda: return "EasyEDA pick and place";
     case Format::kAltium: return "Altium pick and place";
     case Format::kEagle: return "Eagle mountsmd";
     case Format::kDipTrace: return "DipTrace";

@@ -260,6 +260,10 @@ std::string FormatImportSummary(const ImportSummary& s) {
   std::string text = fmt::format("import: {} row{} read ({})", s.rows_read, s.rows_read == 1 ? "" : "s", s.format);
   if (s.rows_with_errors > 0) text += fmt::format(", {} with errors", s.rows_with_errors);
   text += '\n';
+  if (s.encoding == cad::TextEncoding::kWindows1252) {
+    text += "  note:    the list is not UTF-8, so it was read as Windows-1252 (as Altium on Windows writes it);\n"
+            "           check that its letters beyond ASCII (µ, °, ±) read right in the program's comments\n";
+  }
   if (s.failed) {
     text += "  placed:  nothing (see the errors above)\n";
   } else {
@@ -392,6 +396,10 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   summary_.rows_read = reader.rows_read();
   summary_.rows_with_errors = reader.rows_with_errors();
   summary_.format = fmt::format("{}, {}", cad::FormatTitle(reader.format()), cad::UnitName(reader.unit()));
+  summary_.encoding = options_.encoding;
+  if (options_.encoding != cad::TextEncoding::kUtf8) {
+    summary_.format += fmt::format(", {} text", cad::EncodingName(options_.encoding));
+  }
   const SourceRange list_start(SourceLoc{list_file_, 1, 1});
 
   // The side: as asked, or the only one the list places parts on.

@@ -69,6 +69,7 @@ struct ImportOptions {
   bool default_excludes = true;  // FID*, *Fiducial*, *MountingHole* (docs/import.md)
   std::vector<std::string> exclude_designators;  // globs
   std::vector<std::string> exclude_packages;
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;  // what the list was decoded from (cad_encoding.h)
   std::string program_name;  // a valid name; the Program line
   std::string fixture;       // the cell fixture the board is on
   std::vector<std::string> header_lines;  // comment lines opening the program (what was imported, how)
@@ -85,7 +86,8 @@ struct ImportSummary {
   std::size_t boards = 1;
   std::size_t feeders_used = 0;
   std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
-  std::string format;  // "KiCad CSV, mm"
+  std::string format;  // "KiCad CSV, mm" (", Windows-1252 text" when it was decoded)
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;
   // How the bottom side was read, when it is placed: "x negated in the list
   // (KiCad 6.0.11 writes them so (line 2)); rotations as seen from the top;
   // turned over about the board's y axis".
