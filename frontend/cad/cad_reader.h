@@ -43,6 +43,7 @@ struct ReadOptions {
   std::optional<char> delimiter;    // nullopt: from the header line (',', ';', tab, or blanks)
   ColumnMapping mapping;            // kGenericCsv only
   Side side_without_column = Side::kTop;  // the side of rows when the list has no side column
+  bool skip_empty_designators = false;    // a row without a designator: a warning and skipped, not an error
 };
 
 // What a list's preamble says about the tool that wrote it: KiCad's
@@ -66,6 +67,8 @@ class ListReader {
   LengthUnit unit() const { return unit_; }  // the list's length unit
   std::size_t rows_read() const { return rows_read_; }
   std::size_t rows_with_errors() const { return rows_with_errors_; }
+  // Rows left out for having no designator (ReadOptions::skip_empty_designators).
+  std::size_t rows_without_designator() const { return rows_without_designator_; }
   const ToolVersion& tool_version() const { return tool_version_; }
 
  protected:
@@ -74,6 +77,7 @@ class ListReader {
   LengthUnit unit_ = LengthUnit::kMm;
   std::size_t rows_read_ = 0;
   std::size_t rows_with_errors_ = 0;
+  std::size_t rows_without_designator_ = 0;
   ToolVersion tool_version_;
 };
 

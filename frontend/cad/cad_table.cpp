@@ -110,8 +110,13 @@ class TableReader final : public ListReader {
       }
       ++rows_read_;
       const std::size_t errors_before = diags_.error_count();
+      skipped_row_ = false;
       if (split && FitFields(number) && ReadRow(number, row) && diags_.error_count() == errors_before) {
         return true;
+      }
+      if (skipped_row_ && diags_.error_count() == errors_before) {
+        ++rows_without_designator_;
+        continue;
       }
       ++rows_with_errors_;
     }
@@ -288,7 +293,12 @@ class TableReader final : public ListReader {
     Text(Column::kPackage, row.package, row.package_range, number);
     bool ok = true;
     if (row.designator.empty()) {
-      diags_.Report(DiagKind::CadEmptyDesignator, row.designator_range);
+      if (options_.skip_empty_designators) {
+        diags_.Report(DiagKind::CadSkippedEmptyDesignator, RowRange(lines_, number));
+        skipped_row_ = true;
+      } else {
+        diags_.Report(DiagKind::CadEmptyDesignator, row.designator_range);
+      }
       ok = false;
     }
     std::optional<double> x = LengthOf(Column::kX), y = LengthOf(Column::kY);
@@ -342,6 +352,7 @@ class TableReader final : public ListReader {
   ReadOptions options_;
   Diagnostics& diags_;
   Preamble preamble_;
+  bool skipped_row_ = false;  // the row just read was left out (no designator), not wrong
   std::uint32_t header_line_ = 0;
   std::uint32_t next_line_ = 1;
   char delimiter_ = ',';

@@ -113,4 +113,20 @@ ColumnName NormaliseColumnName(std::string_view name);
 // compared ASCII-case-insensitively.
 bool GlobMatch(std::string_view pattern, std::string_view text);
 
+// A feeder's package pattern against a package as CAD tools write it
+// (docs/import.md, "Feeders"):
+//   - a chip size code ("0805", "0402", "01005", or metric "2012Metric")
+//     matches every package of that size, however the tool spells it:
+//     KiCad's C_0805_2012Metric, EasyEDA's C0805, Altium's 0805 and IPC-7351
+//     names such as CAPC2012X135N or RESC2012X65N (metric sizes after an
+//     IPC family, or before "Metric"); "0603" is the imperial 0603 and never
+//     the metric one (C_0201_0603Metric is an 0201);
+//   - anything else is a glob (GlobMatch) in which '-', '_' and spaces do
+//     not count, so "SOT-23" matches SOT23 and SOT_23, "C_0805*" C0805.
+bool PackageMatch(std::string_view pattern, std::string_view package);
+
+// The imperial chip size a package name holds ("0805" for
+// C_0805_2012Metric and CAPC2012X135N), or "" when it names none.
+std::string_view ChipSize(std::string_view package);
+
 }  // namespace smtcal::cad

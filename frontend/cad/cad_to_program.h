@@ -57,12 +57,19 @@ struct ImportOptions {
   AngleRange angles = AngleRange::kSigned;
   double origin_x_mm = 0;  // the board origin in the fixture frame
   double origin_y_mm = 0;
+  // false: the origin was not given, so the parts (of the whole panel) are
+  // centred on `centre_spot` (a point of the fixture frame: the centre of
+  // the first calibrated region on the fixture), or, without one, the
+  // origin is (0, 0); the summary says which.
+  bool origin_given = true;
+  std::optional<std::array<double, 2>> centre_spot;
+  std::string centre_spot_name;  // "region 'layer1'", for the program and the summary
   double rotation_deg = 0;  // the board's x axis against the fixture's
   int columns = 1;          // panel
   int rows = 1;
   double pitch_x_mm = 0;
   double pitch_y_mm = 0;
-  double place_z_mm = 0;  // z of the placements in the board frame
+  double place_z_mm = 0;  // z of the placements in the board frame (the robot z of the board's top)
   int vacuum = 8;         // the program's Vacuum output
   bool skip_unmapped = false;
   bool keep_dnp = false;
@@ -76,7 +83,7 @@ struct ImportOptions {
 };
 
 // Why rows were not placed.
-enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kCount };
+enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kNoDesignator, kCount };
 std::string_view SkipReasonName(SkipReason reason);
 
 struct ImportSummary {
@@ -84,6 +91,8 @@ struct ImportSummary {
   std::size_t rows_with_errors = 0;
   std::size_t parts_placed = 0;  // rows placed (on each board of the panel)
   std::size_t boards = 1;
+  double origin_x_mm = 0;  // where the (first) board's origin went, in the fixture frame
+  double origin_y_mm = 0;
   std::size_t feeders_used = 0;
   std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
   std::string format;  // "KiCad CSV, mm" (", Windows-1252 text" when it was decoded)
@@ -139,6 +148,13 @@ class CadImporter {
   void ReportUnmapped(const std::vector<const Part*>& unmapped);
   // How the bottom side is read (option or cad_bottom.h); fills summary_.bottom.
   cad::BottomPositions DescribeBottom(const cad::ListReader& reader);
+  // Tapes hold one kind of part (package and value): per feeder, the lane
+  // of each part (by index into `parts`) of a bank of tapes; warns about a
+  // single tape given several kinds.
+  // Sets the origin so the parts' centre lands on options_.centre_spot.
+  void PlaceOnSpot(const std::vector<std::array<double, 2>>& on_board, double angle);
+  std::vector<std::unordered_map<std::size_t, int>> AssignTapeLanes(
+      const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder);
   std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side,
                                    cad::BottomPositions bottom_positions);
 
