@@ -128,7 +128,7 @@ void TrimInPlace(std::string& text) {
 }  // namespace
 
 bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, std::vector<Field>& fields,
-                    Diagnostics& diags) {
+                    Diagnostics& diags, bool multiline) {
   std::size_t count = 0;
   std::string_view line = lines.Text(number);
   std::size_t i = 0;
@@ -144,6 +144,11 @@ bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, s
       while (true) {
         if (i >= line.size()) {
           // RFC 4180: a line end inside quotes belongs to the field.
+          if (!multiline) {
+            diags.Report(DiagKind::CsvUnclosedQuote, lines.Range(begin_line, begin, 1));
+            fields.resize(count);
+            return false;
+          }
           if (number >= lines.count()) {
             diags.Report(DiagKind::CadUnclosedQuote, lines.Range(begin_line, begin, 1));
             fields.resize(count);

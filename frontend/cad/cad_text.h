@@ -53,11 +53,14 @@ struct Field {
 };
 
 // Splits a delimited record starting on line `number` (RFC 4180: a field in
-// double quotes may hold the delimiter, "" for a quote, and line ends; then
-// the record runs on to later lines and `number` is advanced to its last
-// line). Returns false after reporting a quoting error.
+// double quotes may hold the delimiter and "" for a quote). With
+// `multiline`, a quoted field may hold line ends too: the record then runs
+// on to later lines and `number` is advanced to its last line (CAD lists);
+// without it a quoted field ends on its own line (the error tables' CSV,
+// frontend/table_csv.h, which splits its lines here too). Returns false
+// after reporting a quoting error.
 bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, std::vector<Field>& fields,
-                    Diagnostics& diags);
+                    Diagnostics& diags, bool multiline = true);
 // Splits a line at runs of spaces and tabs; a field that starts with '"'
 // runs to the closing quote and may hold spaces (Altium's descriptions).
 bool SplitWhitespace(const Lines& lines, std::uint32_t number, std::vector<Field>& fields, Diagnostics& diags);
