@@ -87,8 +87,8 @@ std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
 CLI::Validator PairValidator() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {
-        return ParsePair(text) ? std::string() : "expected X,Y in mm (two numbers, e.g. 10.5,20); write --origin=-5,10 "
-                                                 "when the first is negative";
+        return ParsePair(text) ? std::string() : "expected X,Y in mm: two numbers with a comma between them and no "
+                                                 "space, e.g. 10.5,20 or -5,10";
       },
       "X,Y");
 }
@@ -377,8 +377,8 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   // Where the board is.
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
-                  "X,Y: the board origin in the fixture frame, mm (write --origin=-5,10 when X is negative;\n"
-                  "default: the parts centred on the first calibrated region on the fixture, else 0,0)")
+                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
+                  "on the first calibrated region on the fixture, else 0,0)")
       ->check(PairValidator());
   cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
       ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
