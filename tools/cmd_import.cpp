@@ -39,7 +39,7 @@ struct ImportCliOptions {
   std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
-  std::string origin;  // empty: centred on the fixture's first calibrated region (ImportOptions)
+  std::string origin;  // empty: centred on the fixture's largest calibrated region (BoardSpot)
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
@@ -121,23 +121,28 @@ std::optional<char> ParseDelimiter(const std::string& text) {
 
 void UsageError(const std::string& option, const std::string& message) { throw CLI::ValidationError(option, message); }
 
-// Where a board goes without --origin: the centre of the first calibrated
-// region (in file order) whose centre lies on the fixture, between its
-// markers (0..l1_mm, 0..l2_mm of the fixture frame at its nominal pose), in
-// fixture coordinates. nullopt when the fixture carries no region.
+// Where a board goes without --origin: the centre of the largest calibrated
+// region (the first in file order among equals) whose centre lies on the
+// fixture, between its markers (0..l1_mm, 0..l2_mm of the fixture frame at
+// its nominal pose), in fixture coordinates: a placing area, not a small
+// region calibrated under a marker. nullopt when the fixture carries none.
 std::optional<std::pair<std::array<double, 2>, std::string>> BoardSpot(const cell::Cell& cell,
                                                                        const cell::Fixture& fixture) {
   const double angle = fixture.angle_deg * std::numbers::pi / 180.0;
+  std::optional<std::pair<std::array<double, 2>, std::string>> spot;
+  double largest = 0;
   for (const cell::Region& region : cell.regions) {
     const double dx = (region.x_mm.lo + region.x_mm.hi) / 2 - fixture.origin_mm.x();
     const double dy = (region.y_mm.lo + region.y_mm.hi) / 2 - fixture.origin_mm.y();
     const double fx = std::cos(angle) * dx + std::sin(angle) * dy;
     const double fy = -std::sin(angle) * dx + std::cos(angle) * dy;
-    if (fx >= 0 && fx <= fixture.l1_mm && fy >= 0 && fy <= fixture.l2_mm) {
-      return std::make_pair(std::array<double, 2>{fx, fy}, fmt::format("region '{}'", region.name));
+    const double area = (region.x_mm.hi - region.x_mm.lo) * (region.y_mm.hi - region.y_mm.lo);
+    if (fx >= 0 && fx <= fixture.l1_mm && fy >= 0 && fy <= fixture.l2_mm && area > largest) {
+      largest = area;
+      spot = std::make_pair(std::array<double, 2>{fx, fy}, fmt::format("region '{}'", region.name));
     }
   }
-  return std::nullopt;
+  return spot;
 }
 
 // The fixture the board is on: --fixture, or the cell's only one.
@@ -378,7 +383,7 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
                   "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
-                  "on the first calibrated region on the fixture, else 0,0)")
+                  "on the largest calibrated region on the fixture, else 0,0)")
       ->check(PairValidator());
   cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
       ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));

@@ -59,7 +59,7 @@ struct ImportOptions {
   double origin_y_mm = 0;
   // false: the origin was not given, so the parts (of the whole panel) are
   // centred on `centre_spot` (a point of the fixture frame: the centre of
-  // the first calibrated region on the fixture), or, without one, the
+  // the largest calibrated region on the fixture), or, without one, the
   // origin is (0, 0); the summary says which.
   bool origin_given = true;
   std::optional<std::array<double, 2>> centre_spot;
