@@ -5,12 +5,15 @@
 //
 // The families, one reader file each:
 //   cad_kicad.cpp   KiCad ASCII .pos (both header generations, mm or inch) and KiCad CSV
-//   cad_altium.cpp  Altium pick-and-place reports, text and CSV, both generations
+//   cad_altium.cpp  Altium pick-and-place reports, text and CSV, both generations, and
+//                   EasyEDA's (Protel's Mid/Ref/Pad layout, UTF-16 with tabs)
 //   cad_csv.cpp     JLCPCB CPL / Fabrication Toolkit, DipTrace 3.x and 4.x, generic CSV
 //   cad_eagle.cpp   Eagle mountsmd .mnt/.mnb (no header)
 // The header-driven families share the table reader in cad_table.cpp;
 // cad_detect.cpp tells the formats apart; cad_text.cpp splits and reads
-// fields. Every data row becomes a Row or a diagnostic at its line.
+// fields; cad_encoding.cpp decodes UTF-16 and Windows-1252 lists first;
+// cad_bottom.cpp decides how a list writes its bottom side. Every data row
+// becomes a Row or a diagnostic at its line.
 #pragma once
 
 #include <array>
