@@ -169,8 +169,19 @@ struct Fixture {
   std::vector<Point2> teach_trips_mm;
   std::vector<SourceRange> teach_trip_ranges;  // one per trip: its [x, y]
   SourceRange teach_range;  // the teach_trips_mm key (the [[fixture]] table when absent)
+  // The robot z at which a part is released on a board on this fixture (the
+  // board's top): the z of every placement `smtcal import` writes. Absent:
+  // import asks for --place-z instead of guessing.
+  std::optional<double> place_z_mm;
+  SourceRange place_z_range;  // the place_z_mm key
   SourceRange range;  // the [[fixture]] table
 };
+
+// What a feeder holds, for CAD import: a tape gives every part of one kind
+// from the same pick point (a pallet of tapes is a bank of lanes, one kind
+// of part each); a tray holds one part per pocket, taken in order.
+enum class FeederKind { kTape, kTray };
+inline constexpr std::array<std::string_view, 2> kFeederKindNames = {"tape", "tray"};
 
 // [[feeder]]: a named pick point in the robot base frame, optionally a pallet
 // of pick points (columns along from -> last, rows along from -> back).
@@ -189,6 +200,10 @@ struct Feeder {
   std::string package;
   std::vector<std::string> packages;
   std::string value;
+  // `kind`; without the key: a tape, except a pallet whose pick points do
+  // not each have a package of their own, which is a tray.
+  FeederKind kind = FeederKind::kTape;
+  SourceRange kind_range;  // the kind key (the [[feeder]] table when absent)
   SourceRange range;  // the [[feeder]] table
 };
 

@@ -909,6 +909,11 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   std::optional<Located<double>> scan_z = Number(keys, "scan_z_mm", Need::kRequired, "mm");
   if (scan_z) fixture.scan_z_mm = scan_z->value;
   fixture.scan_speed_range = keys.KeyRange("scan_speed_mm_s");
+  std::optional<Located<double>> place_z = Number(keys, "place_z_mm", Need::kOptional, "mm");
+  if (place_z) {
+    fixture.place_z_mm = place_z->value;
+    fixture.place_z_range = keys.KeyRange("place_z_mm");
+  }
   fixture.scan_speed_mm_s = PositiveNumber(keys, "scan_speed_mm_s", "mm/s").value_or(0);
   std::optional<double> window = PositiveNumber(keys, "trip_window_mm", "mm");
   fixture.trip_window_mm = window.value_or(0);
@@ -949,6 +954,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
     }
   }
   if (scan_z) CheckInLimit(2, scan_z->value, keys.KeyRange("scan_z_mm"), "'scan_z_mm'");
+  if (place_z) CheckInLimit(2, place_z->value, keys.KeyRange("place_z_mm"), "'place_z_mm'");
   if (diags_.error_count() != errors_before) return std::nullopt;
   return fixture;
 }
@@ -991,6 +997,8 @@ std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
   if (auto value = String(keys, "value", Need::kOptional, "a string: the part value it holds")) {
     feeder.value = value->value;
   }
+  std::optional<int> kind = Choice(keys, "kind", kFeederKindNames);
+  feeder.kind_range = kind ? keys.KeyRange("kind") : feeder.range;
 
   const toml::table* pallet = TableAt(keys, "pallet", Need::kOptional,
                                       "a table { last = [x, y, z, u], back = [x, y, z, u], columns = N, rows = N }");
@@ -1010,6 +1018,16 @@ std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
     feeder.rows = rows.value_or(1);
   }
   keys.Finish();
+  const int pick_points = feeder.columns * feeder.rows;
+  feeder.kind = kind ? static_cast<FeederKind>(*kind)
+                     : pallet != nullptr && !(pick_points > 1 && static_cast<int>(feeder.packages.size()) == pick_points)
+                         ? FeederKind::kTray
+                         : FeederKind::kTape;
+  if (feeder.kind == FeederKind::kTray && pallet == nullptr) {
+    diags_.Report(DiagKind::CellMissingKey, feeder.kind_range, title, "pallet",
+                  "a tray is a pallet of pockets, pallet = { last = [x, y, z, u], back = [x, y, z, u], columns = N, "
+                  "rows = N }; a single pick point is a tape (kind = \"tape\")");
+  }
 
   const std::size_t errors_before_limits = diags_.error_count();
   if (pick) CheckPointInLimits(pick->value, pick->range, fmt::format("'pick' of {}", title));

@@ -143,7 +143,7 @@ class Reader {
     const std::size_t errors_before = diags_.error_count();
     FeederSpec feeder;
     feeder.range = Range(table);
-    CheckKeys(table, "[[feeder]]", {"name", "pick", "package", "value", "rotation_offset_deg", "pallet"});
+    CheckKeys(table, "[[feeder]]", {"name", "pick", "package", "value", "rotation_offset_deg", "kind", "pallet"});
     if (std::optional<std::string> name = String(table, "name", &feeder.name_range)) feeder.name = *name;
     if (!table.contains("name")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'name'");
     if (std::optional<std::array<double, 4>> pick = Point(table, "pick")) feeder.pick = *pick;
@@ -179,6 +179,20 @@ class Reader {
         diags_.Report(DiagKind::FeedersWrongType, Range(*node), "pallet",
                       "a table { last = [x, y, z, u], back = [x, y, z, u], columns = N, rows = N }", TomlTypeName(*node));
       }
+    }
+    SourceRange kind_range = feeder.range;
+    std::optional<std::string> kind = String(table, "kind", &kind_range);
+    if (kind && *kind != "tape" && *kind != "tray") {
+      diags_.Report(DiagKind::FeedersBadValue, kind_range, "kind", "\"tape\" or \"tray\"", fmt::format("'{}'", Printable(*kind)));
+    }
+    const bool bank = feeder.is_pallet() && feeder.pick_points() > 1 &&
+                      static_cast<int>(feeder.packages.size()) == feeder.pick_points();
+    feeder.kind = kind ? (*kind == "tray" ? cell::FeederKind::kTray : cell::FeederKind::kTape)
+                       : feeder.is_pallet() && !bank ? cell::FeederKind::kTray
+                                                     : cell::FeederKind::kTape;
+    if (feeder.kind == cell::FeederKind::kTray && !feeder.is_pallet()) {
+      diags_.Report(DiagKind::FeedersMissingKey, kind_range, "a tray",
+                    "a pallet of pockets (pallet = { last = [..], back = [..], columns = N, rows = N })");
     }
     if (diags_.error_count() != errors_before) return std::nullopt;
     return feeder;
@@ -223,6 +237,7 @@ FeederSpec FromCell(const cell::Feeder& feeder) {
   spec.packages = feeder.packages;
   if (spec.packages.empty() && !feeder.package.empty()) spec.packages.push_back(feeder.package);
   spec.value = feeder.value;
+  spec.kind = feeder.kind;
   spec.from_cell = true;
   return spec;
 }
@@ -241,13 +256,10 @@ int Specificity(const FeederSpec& feeder, const Row& row, std::optional<int>& la
   int score = 0;
   if (!feeder.packages.empty()) {
     auto it = std::find_if(feeder.packages.begin(), feeder.packages.end(),
-                           [&](const std::string& pattern) { return GlobMatch(pattern, row.package); });
+                           [&](const std::string& pattern) { return PackageMatch(pattern, row.package); });
     if (it == feeder.packages.end()) return 0;
-    // A pallet with one package per pick point is a bank of lanes.
-    if (feeder.is_pallet() && static_cast<int>(feeder.packages.size()) == feeder.pick_points() &&
-        feeder.pick_points() > 1) {
-      lane = static_cast<int>(it - feeder.packages.begin()) + 1;
-    }
+    // A bank of tapes with one package per lane: the lane of the package.
+    if (feeder.lanes_by_package()) lane = static_cast<int>(it - feeder.packages.begin()) + 1;
     ++score;
   }
   if (!feeder.value.empty()) {
@@ -321,7 +333,7 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
 std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
   for (std::size_t r = 0; r < rules_.size(); ++r) {
     const FeederRule& rule = rules_[r];
-    if (!rule.package.empty() && !GlobMatch(rule.package, row.package)) continue;
+    if (!rule.package.empty() && !PackageMatch(rule.package, row.package)) continue;
     if (!rule.value.empty() && !GlobMatch(rule.value, row.value)) continue;
     if (!rule.designator.empty() && !GlobMatch(rule.designator, row.designator)) continue;
     return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg};

@@ -9,6 +9,7 @@
 //   package = "SOT-23*"                 # globs, any case; a string or an array
 //   value = "BC847*"
 //   rotation_offset_deg = 180.0         # added to the part's rotation (orientation in the tape)
+//   kind = "tape"                       # or "tray" (cell.h, FeederKind)
 //   pallet = { last = [..], back = [..], columns = 4, rows = 2 }
 //
 //   [[map]]                             # first matching rule wins
@@ -50,9 +51,15 @@ struct FeederSpec {
   std::vector<std::string> packages;  // globs; empty = any package
   std::string value;                  // glob; empty = any value
   double rotation_offset_deg = 0;
+  cell::FeederKind kind = cell::FeederKind::kTape;  // as the cell's `kind` (cell.h), same default
   bool from_cell = false;
 
   bool is_pallet() const { return pallet_last.has_value(); }
+  // A pallet of tapes whose `package` array names each lane's package.
+  bool lanes_by_package() const {
+    return kind == cell::FeederKind::kTape && is_pallet() && pick_points() > 1 &&
+           static_cast<int>(packages.size()) == pick_points();
+  }
   int pick_points() const { return columns * rows; }
 };
 

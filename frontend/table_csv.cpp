@@ -14,78 +14,10 @@
 #include "base/check.h"
 #include "base/field_text.h"
 #include "calibration/tolerances.h"
+#include "frontend/cad/cad_text.h"
 
 namespace smtcal {
 namespace {
-
-bool IsBlank(char c) { return c == ' ' || c == '\t'; }
-
-SourceLoc At(std::uint32_t file, std::uint32_t line, std::size_t offset) {
-  return SourceLoc{file, line, static_cast<std::uint32_t>(offset + 1)};
-}
-
-// Splits one line (without its line end) into fields. Returns false (after
-// reporting) on a quoting error.
-bool SplitLine(std::string_view line, std::uint32_t file, std::uint32_t number, std::size_t start,
-               CsvRecord& record, Diagnostics& diags) {
-  std::size_t i = start;
-  while (true) {
-    while (i < line.size() && IsBlank(line[i])) ++i;
-    CsvField field;
-    std::size_t begin = i;
-    if (i < line.size() && line[i] == '"') {
-      ++i;
-      while (true) {
-        if (i >= line.size()) {
-          diags.Report(DiagKind::CsvUnclosedQuote, SourceRange(At(file, number, begin), 1));
-          return false;
-        }
-        if (line[i] == '"') {
-          if (i + 1 < line.size() && line[i + 1] == '"') {
-            field.text += '"';
-            i += 2;
-            continue;
-          }
-          ++i;
-          break;
-        }
-        field.text += line[i++];
-      }
-      std::size_t end = i;
-      while (i < line.size() && IsBlank(line[i])) ++i;
-      if (i < line.size() && line[i] != ',') {
-        diags.Report(DiagKind::CsvStrayQuote, SourceRange(At(file, number, i), 1),
-                     "text after the closing quote of a field");
-        return false;
-      }
-      field.range = SourceRange(At(file, number, begin), static_cast<std::uint32_t>(end - begin));
-      // Spaces inside the quotes are kept out of numbers too.
-      std::string_view inner = field.text;
-      while (!inner.empty() && IsBlank(inner.front())) inner.remove_prefix(1);
-      while (!inner.empty() && IsBlank(inner.back())) inner.remove_suffix(1);
-      field.text = std::string(inner);
-    } else {
-      while (i < line.size() && line[i] != ',') {
-        if (line[i] == '"') {
-          diags.Report(DiagKind::CsvStrayQuote, SourceRange(At(file, number, i), 1),
-                       "'\"' inside an unquoted field");
-          return false;
-        }
-        ++i;
-      }
-      std::size_t end = i;
-      while (end > begin && IsBlank(line[end - 1])) --end;
-      field.text = std::string(line.substr(begin, end - begin));
-      field.range = SourceRange(At(file, number, begin), static_cast<std::uint32_t>(end - begin));
-    }
-    record.fields.push_back(std::move(field));
-    if (i < line.size() && line[i] == ',') {
-      ++i;
-      continue;
-    }
-    return true;
-  }
-}
 
 // ------------------------------------------------------------------ columns
 
@@ -378,20 +310,23 @@ std::optional<std::vector<T>> ReadRows(std::uint32_t file, const Schema& schema,
 }  // namespace
 
 std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
-  const SourceFile& source = diags.sources().File(file);
+  // The lines and fields are split as the CAD lists' (frontend/cad/cad_text.h),
+  // with ',' between fields and every quoted field ending on its own line.
+  const cad::Lines lines(diags.sources(), file);
   std::vector<CsvRecord> records;
-  const auto line_count = static_cast<std::uint32_t>(source.line_starts.size());
-  for (std::uint32_t number = 1; number <= line_count; ++number) {
-    std::string_view line = source.Line(number);
-    std::size_t start = 0;
-    if (number == 1 && line.starts_with("\xEF\xBB\xBF")) start = 3;  // UTF-8 byte order mark
-    std::size_t first = start;
-    while (first < line.size() && (IsBlank(line[first]) || line[first] == '\r')) ++first;
-    if (first == line.size() || line[first] == '#') continue;
+  std::vector<cad::Field> fields;
+  for (std::uint32_t number = 1; number <= lines.count(); ++number) {
+    std::string_view line = lines.Text(number);
+    std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos || line[first] == '#') continue;
+    std::uint32_t last = number;
+    if (!cad::SplitDelimited(lines, last, ',', fields, diags, /*multiline=*/false)) continue;
     CsvRecord record;
     record.line = number;
-    record.end = At(file, number, line.size());
-    if (SplitLine(line, file, number, start, record, diags)) records.push_back(std::move(record));
+    record.end = lines.At(number, line.size());
+    record.fields.reserve(fields.size());
+    for (cad::Field& field : fields) record.fields.push_back(CsvField{std::move(field.text), field.range});
+    records.push_back(std::move(record));
   }
   return records;
 }

@@ -5,7 +5,10 @@
 // options and exit codes.
 #include <algorithm>
 #include <cmath>
+#include <cctype>
+#include <cstring>
 #include <filesystem>
+#include <numbers>
 
 #include <fmt/core.h>
 
@@ -33,15 +36,17 @@ struct ImportCliOptions {
   std::string columns;
   std::string side;
   std::string mirror;
+  std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
-  std::string origin = "0,0";
+  std::string origin;  // empty: centred on the fixture's largest calibrated region (BoardSpot)
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
-  double place_z_mm = 0;
+  std::optional<double> place_z_mm;  // else the fixture's place_z_mm
   int vacuum = 8;
   bool skip_unmapped = false;
+  bool skip_empty_designators = false;
   bool keep_dnp = false;
   bool no_default_excludes = false;
   std::vector<std::string> exclude_designators;
@@ -49,6 +54,18 @@ struct ImportCliOptions {
   std::string fixture;
   std::string name;
 };
+
+// A path as a shell word: quoted when it holds anything but letters,
+// digits and / . _ - + , = : @ (for the command the summary suggests).
+std::string ShellWord(const std::string& path) {
+  bool plain = !path.empty() && std::all_of(path.begin(), path.end(), [](unsigned char c) {
+    return std::isalnum(c) || std::strchr("/._-+,=:@", c) != nullptr;
+  });
+  if (plain) return path;
+  std::string quoted = "'";
+  for (char c : path) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
 
 std::string BaseName(const std::string& path) {
   return path == "-" ? "<stdin>" : std::filesystem::path(path).filename().string();
@@ -70,8 +87,8 @@ std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
 CLI::Validator PairValidator() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {
-        return ParsePair(text) ? std::string() : "expected X,Y in mm (two numbers, e.g. 10.5,20); write --origin=-5,10 "
-                                                 "when the first is negative";
+        return ParsePair(text) ? std::string() : "expected X,Y in mm: two numbers with a comma between them and no "
+                                                 "space, e.g. 10.5,20 or -5,10";
       },
       "X,Y");
 }
@@ -104,6 +121,30 @@ std::optional<char> ParseDelimiter(const std::string& text) {
 
 void UsageError(const std::string& option, const std::string& message) { throw CLI::ValidationError(option, message); }
 
+// Where a board goes without --origin: the centre of the largest calibrated
+// region (the first in file order among equals) whose centre lies on the
+// fixture, between its markers (0..l1_mm, 0..l2_mm of the fixture frame at
+// its nominal pose), in fixture coordinates: a placing area, not a small
+// region calibrated under a marker. nullopt when the fixture carries none.
+std::optional<std::pair<std::array<double, 2>, std::string>> BoardSpot(const cell::Cell& cell,
+                                                                       const cell::Fixture& fixture) {
+  const double angle = fixture.angle_deg * std::numbers::pi / 180.0;
+  std::optional<std::pair<std::array<double, 2>, std::string>> spot;
+  double largest = 0;
+  for (const cell::Region& region : cell.regions) {
+    const double dx = (region.x_mm.lo + region.x_mm.hi) / 2 - fixture.origin_mm.x();
+    const double dy = (region.y_mm.lo + region.y_mm.hi) / 2 - fixture.origin_mm.y();
+    const double fx = std::cos(angle) * dx + std::sin(angle) * dy;
+    const double fy = -std::sin(angle) * dx + std::cos(angle) * dy;
+    const double area = (region.x_mm.hi - region.x_mm.lo) * (region.y_mm.hi - region.y_mm.lo);
+    if (fx >= 0 && fx <= fixture.l1_mm && fy >= 0 && fy <= fixture.l2_mm && area > largest) {
+      largest = area;
+      spot = std::make_pair(std::array<double, 2>{fx, fy}, fmt::format("region '{}'", region.name));
+    }
+  }
+  return spot;
+}
+
 // The fixture the board is on: --fixture, or the cell's only one.
 const cell::Fixture* ChooseFixture(const cell::Cell& cell, const std::string& wanted, Diagnostics& diags) {
   const SourceRange cell_start(SourceLoc{cell.file, 1, 1});
@@ -134,6 +175,7 @@ const cell::Fixture* ChooseFixture(const cell::Cell& cell, const std::string& wa
 
 cad::ReadOptions MakeReadOptions(const ImportCliOptions& opt) {
   cad::ReadOptions read;
+  read.skip_empty_designators = opt.skip_empty_designators;
   if (!opt.format.empty()) read.format = cad::FormatFromName(opt.format);
   if (!opt.units.empty()) read.units = cad::UnitFromName(opt.units);
   if (!opt.delimiter.empty()) read.delimiter = ParseDelimiter(opt.delimiter);
@@ -164,9 +206,13 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   if (opt.mirror == "none") import.mirror = ImportMirror::kNone;
   if (opt.mirror == "x") import.mirror = ImportMirror::kX;
   if (opt.mirror == "y") import.mirror = ImportMirror::kY;
+  if (opt.bottom_positions == "top-view") import.bottom_positions = cad::BottomPositions::kTopView;
+  if (opt.bottom_positions == "negated-x") import.bottom_positions = cad::BottomPositions::kNegatedX;
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
-  std::array<double, 2> origin = *ParsePair(opt.origin), pitch = *ParsePair(opt.pitch);
+  std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : *ParsePair(opt.origin);
+  std::array<double, 2> pitch = *ParsePair(opt.pitch);
+  import.origin_given = !opt.origin.empty();
   std::array<int, 2> panel = *ParsePanel(opt.panel);
   import.origin_x_mm = origin[0];
   import.origin_y_mm = origin[1];
@@ -175,7 +221,7 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   import.rows = panel[1];
   import.pitch_x_mm = pitch[0];
   import.pitch_y_mm = pitch[1];
-  import.place_z_mm = opt.place_z_mm;
+  import.place_z_mm = opt.place_z_mm.value_or(fixture.place_z_mm.value_or(0.0));
   import.vacuum = opt.vacuum;
   import.skip_unmapped = opt.skip_unmapped;
   import.keep_dnp = opt.keep_dnp;
@@ -194,6 +240,12 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
 
 void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
+  std::vector<std::string> inputs = {opt.list, opt.cell};
+  if (!opt.feeders.empty()) inputs.push_back(opt.feeders);
+  if (OutputOverwritesInput("-o", opt.output, inputs)) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
@@ -214,6 +266,9 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     }
     if (file.value()) feeders_file = std::move(*file.value());
   }
+  if (fixture != nullptr && !opt.place_z_mm && !fixture->place_z_mm) {
+    diags.Report(DiagKind::ImportNoPlaceZ, fixture->name_range, fixture->name);
+  }
   if (!cell || fixture == nullptr || diags.has_errors()) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
@@ -225,32 +280,66 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     options.exit_code = ReportIoError(list.error());
     return;
   }
-  std::unique_ptr<cad::ListReader> reader = cad::OpenList(list.value(), read, diags);
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;
+  std::optional<std::uint32_t> list_file = cad::DecodeList(list.value(), sources, diags, encoding);
+  std::unique_ptr<cad::ListReader> reader = list_file ? cad::OpenList(*list_file, read, diags) : nullptr;
   if (!feeders || !reader) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
 
   ImportOptions import = MakeImportOptions(opt, *fixture);
+  import.encoding = encoding;
+  if (auto spot = BoardSpot(*cell, *fixture)) {
+    import.centre_spot = spot->first;
+    import.centre_spot_name = spot->second;
+  }
+  const bool origin_given = import.origin_given;
+  const std::string spot_name = import.centre_spot ? import.centre_spot_name : std::string();
+  const std::string place_z_source =
+      opt.place_z_mm ? std::string("--place-z") : fmt::format("place_z_mm of fixture {}", fixture->name);
+  const double place_z = import.place_z_mm;
   import.header_lines = {
-      fmt::format("Imported by smtcal import from {} ({}, {}).", BaseName(opt.list), cad::FormatTitle(reader->format()),
-                  cad::UnitName(reader->unit())),
+      fmt::format("Imported by smtcal import from {} ({}, {}{}).", BaseName(opt.list),
+                  cad::FormatTitle(reader->format()), cad::UnitName(reader->unit()),
+                  encoding == cad::TextEncoding::kUtf8 ? "" : fmt::format(", {} text", cad::EncodingName(encoding))),
       fmt::format("Cell {}, fixture {}{}.", BaseName(opt.cell), fixture->name,
                   opt.feeders.empty() ? "" : ", feeders " + BaseName(opt.feeders)),
       "To change it, change the list, the cell, the feeders or the options and import again.",
   };
-  CadImporter importer(*feeders, std::move(import), list.value(), diags);
+  CadImporter importer(*feeders, std::move(import), *list_file, diags);
   cad::Row row;
   while (reader->Next(row)) importer.Add(row);
   std::optional<ir::Program> program = importer.Finish(*reader);
   options.exit_code = PrintDiagnostics(diags, options);
-  std::fputs(FormatImportSummary(importer.summary()).c_str(), stderr);
+  std::string summary = FormatImportSummary(importer.summary());
+  if (program) {
+    const ImportSummary& s = importer.summary();
+    summary += fmt::format("  board:   origin ({}, {}) mm in fixture {}{}\n  place:   at z = {} mm ({})\n",
+                           s.origin_x_mm, s.origin_y_mm, fixture->name,
+                           origin_given       ? " (--origin)"
+                           : spot_name.empty() ? fmt::format(": the fixture carries no calibrated region to centre the "
+                                                             "parts on; give --origin X,Y")
+                                               : fmt::format(", the parts centred on {} (--origin X,Y to place the "
+                                                             "board elsewhere)",
+                                                             spot_name),
+                           place_z, place_z_source);
+  }
   if (options.exit_code != kExitOk || !program) {
+    std::fputs(summary.c_str(), stderr);
     options.exit_code = kExitInputError;
     return;  // nothing half-written
   }
   Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
-  if (!written) options.exit_code = ReportIoError(written.error());
+  if (!written) {
+    std::fputs(summary.c_str(), stderr);
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  if (opt.output != "-") {
+    summary += fmt::format("  next:    smtcal verify {} --cell {}\n", ShellWord(opt.output), ShellWord(opt.cell));
+  }
+  std::fputs(summary.c_str(), stderr);
 }
 
 }  // namespace
@@ -268,7 +357,7 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
 
   // The list.
   cmd->add_option("--format", opt.format, "the list's format when detection is not wanted")
-      ->check(CLI::IsMember({"kicad-pos", "kicad-csv", "jlcpcb", "altium", "eagle", "diptrace", "csv"}));
+      ->check(CLI::IsMember(std::vector<std::string>(std::begin(cad::kFormatNames), std::end(cad::kFormatNames))));
   cmd->add_option("--columns", opt.columns,
                   "for --format csv: KEY=COLUMN,... with keys designator, x, y (needed) and rotation, value,\n"
                   "package, side, dnp; columns by header name or 1-based number (then there is no header)");
@@ -284,6 +373,8 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
                   "the side to place: top or bottom (default: the only side the list has parts on; a list\n"
                   "without a side column is on this side, Eagle's .mnb on the bottom)")
       ->check(CLI::IsMember({"top", "bottom"}));
+  cmd->add_flag("--skip-empty-designators", opt.skip_empty_designators,
+                "leave out rows without a designator (each is reported) instead of failing");
   cmd->add_flag("--skip-unmapped", opt.skip_unmapped, "leave out parts no feeder holds (each is listed) instead of "
                                                       "failing");
   cmd->add_flag("--keep-dnp", opt.keep_dnp, "place parts a DNP column or a DNP/DNF value marks do-not-place");
@@ -296,7 +387,9 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
 
   // Where the board is.
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
-  cmd->add_option("--origin", opt.origin, "X,Y: the board origin in the fixture frame, mm (default 0,0)")
+  cmd->add_option("--origin", opt.origin,
+                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
+                  "on the largest calibrated region on the fixture, else 0,0)")
       ->check(PairValidator());
   cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
       ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
@@ -304,6 +397,11 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
                   "the board coordinate that changes sign: none, x or y (default: none for the top side, x for\n"
                   "the bottom side, the board turned over about its y axis)")
       ->check(CLI::IsMember({"none", "x", "y"}));
+  cmd->add_option("--bottom-positions", opt.bottom_positions,
+                  "how the list gives bottom-side x: top-view (as seen from the top) or negated-x (as seen\n"
+                  "from the bottom: KiCad 6 and older, KiCad's 'negative X'); default: detected, and the\n"
+                  "summary says what was applied and why")
+      ->check(CLI::IsMember({"top-view", "negated-x"}));
   cmd->add_option("--bottom-rotation", opt.bottom_rotation,
                   "how the list gives bottom-side rotations: top-view (as seen through the board from the top,\n"
                   "mirrored with the positions) or bottom-view (as seen from below, kept)")
@@ -317,7 +415,9 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
           "CxR"));
   cmd->add_option("--pitch", opt.pitch, "DX,DY: the distance between the panel's boards along its x and y, mm")
       ->check(PairValidator());
-  cmd->add_option("--place-z", opt.place_z_mm, "z of the placements in the board frame, mm (default 0)")
+  cmd->add_option("--place-z", opt.place_z_mm,
+                  "z of the placements, mm: the robot z of the board's top (default: the fixture's place_z_mm\n"
+                  "in the cell; without either it is an error)")
       ->check(CLI::Range(-kMaxLengthMm, kMaxLengthMm));
 
   // The program.

@@ -24,7 +24,7 @@ namespace smtcal::cad {
 namespace {
 
 // "Units used: mil" (possibly quoted, in the CSV report).
-bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<StatedUnit>& unit, Diagnostics& diags) {
+bool AltiumUnitLine(const Lines& lines, std::uint32_t number, Preamble& preamble, Diagnostics& diags) {
   std::string_view text = lines.Text(number);
   constexpr std::string_view kKey = "Units used:";
   std::size_t key = text.find(kKey);
@@ -40,7 +40,7 @@ bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<Stat
                  " in the report's 'Units used'");
     return false;
   }
-  unit = StatedUnit{*parsed, lines.Range(number, begin, word.size())};
+  preamble.unit = StatedUnit{*parsed, lines.Range(number, begin, word.size())};
   return true;
 }
 
@@ -49,28 +49,31 @@ bool AltiumUnitLine(const Lines& lines, std::uint32_t number, std::optional<Stat
 Dialect AltiumDialect() {
   Dialect dialect;
   dialect.format = Format::kAltium;
-  dialect.aliases = {
-      {"designator", "Designator", Column::kDesignator, 0},
-      {"comment", "Comment", Column::kValue, 0},
-      {"footprint", "Footprint", Column::kPackage, 0},
-      {"centerx", "Center-X", Column::kX, 0},
-      {"midx", "Mid X", Column::kX, 0},
-      {"refx", "Ref X", Column::kX, 1},
-      {"padx", "Pad X", Column::kX, 2},
-      {"centery", "Center-Y", Column::kY, 0},
-      {"midy", "Mid Y", Column::kY, 0},
-      {"refy", "Ref Y", Column::kY, 1},
-      {"pady", "Pad Y", Column::kY, 2},
-      {"rotation", "Rotation", Column::kRotation, 0},
-      {"layer", "Layer", Column::kSide, 0},
-      {"tb", "TB", Column::kSide, 0},
-      {"dnp", "DNP", Column::kDnp, 0},
-  };
-  for (Column c : {Column::kDesignator, Column::kX, Column::kY, Column::kRotation}) {
-    dialect.required[static_cast<int>(c)] = true;
-  }
+  dialect.aliases = MakeAliases({{Column::kDesignator, {"Designator"}},
+                                 {Column::kValue, {"Comment"}},
+                                 {Column::kPackage, {"Footprint"}},
+                                 {Column::kX, {"Center-X|Mid X", "Ref X", "Pad X"}},
+                                 {Column::kY, {"Center-Y|Mid Y", "Ref Y", "Pad Y"}},
+                                 {Column::kRotation, {"Rotation"}},
+                                 {Column::kSide, {"Layer|TB"}},
+                                 {Column::kDnp, {"DNP"}}});
+  dialect.required = RequiredColumns({Column::kDesignator, Column::kX, Column::kY, Column::kRotation});
   dialect.fixed_width = true;
   dialect.preamble = AltiumUnitLine;
+  return dialect;
+}
+
+// EasyEDA (std and Pro, the editor behind JLCPCB) writes Protel's layout
+// too, as UTF-16 LE text with a byte order mark and tabs between fields
+// (cad_encoding.h decodes it), values with their unit ("62.6mm"):
+//   Designator<TAB>Footprint<TAB>Mid X<TAB>Mid Y<TAB>Ref X<TAB>Ref Y<TAB>Pad X<TAB>Pad Y<TAB>Layer<TAB>Rotation<TAB>Comment
+//   C1<TAB>C0805<TAB>62.6mm<TAB>71.25mm<TAB>...<TAB>T<TAB>0<TAB>10uF
+// Mid X/Y is the part's centre; layers T/B.
+Dialect EasyEdaDialect() {
+  Dialect dialect = AltiumDialect();
+  dialect.format = Format::kEasyEda;
+  dialect.fixed_width = false;
+  dialect.preamble = nullptr;
   return dialect;
 }
 

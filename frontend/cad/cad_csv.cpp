@@ -21,12 +21,6 @@
 namespace smtcal::cad {
 namespace {
 
-std::array<bool, kColumnCount> Required(std::initializer_list<Column> columns) {
-  std::array<bool, kColumnCount> required{};
-  for (Column c : columns) required[static_cast<int>(c)] = true;
-  return required;
-}
-
 // Placement lists have a dozen columns; a larger number is a typo.
 constexpr int kMaxColumnNumber = 1000;
 
@@ -39,46 +33,30 @@ bool IsColumnNumber(std::string_view text) {
 Dialect JlcpcbDialect() {
   Dialect dialect;
   dialect.format = Format::kJlcpcb;
-  dialect.aliases = {
-      {"designator", "Designator", Column::kDesignator, 0},
-      {"ref", "Ref", Column::kDesignator, 1},
-      {"val", "Val", Column::kValue, 0},
-      {"value", "Value", Column::kValue, 0},
-      {"comment", "Comment", Column::kValue, 1},
-      {"package", "Package", Column::kPackage, 0},
-      {"footprint", "Footprint", Column::kPackage, 1},
-      {"midx", "Mid X", Column::kX, 0},
-      {"posx", "PosX", Column::kX, 1},
-      {"midy", "Mid Y", Column::kY, 0},
-      {"posy", "PosY", Column::kY, 1},
-      {"rotation", "Rotation", Column::kRotation, 0},
-      {"rot", "Rot", Column::kRotation, 1},
-      {"layer", "Layer", Column::kSide, 0},
-      {"side", "Side", Column::kSide, 1},
-      {"dnp", "DNP", Column::kDnp, 0},
-  };
-  dialect.required = Required({Column::kDesignator, Column::kX, Column::kY, Column::kRotation, Column::kSide});
+  dialect.aliases = MakeAliases({{Column::kDesignator, {"Designator", "Ref"}},
+                                 {Column::kValue, {"Val|Value", "Comment"}},
+                                 {Column::kPackage, {"Package", "Footprint"}},
+                                 {Column::kX, {"Mid X", "PosX"}},
+                                 {Column::kY, {"Mid Y", "PosY"}},
+                                 {Column::kRotation, {"Rotation", "Rot"}},
+                                 {Column::kSide, {"Layer", "Side"}},
+                                 {Column::kDnp, {"DNP"}}});
+  dialect.required = RequiredColumns({Column::kDesignator, Column::kX, Column::kY, Column::kRotation, Column::kSide});
   return dialect;
 }
 
 Dialect DipTraceDialect() {
   Dialect dialect;
   dialect.format = Format::kDipTrace;
-  dialect.aliases = {
-      {"refdes", "RefDes", Column::kDesignator, 0},
-      {"value", "Value", Column::kValue, 0},
-      {"pattern", "Pattern", Column::kPackage, 0},
-      {"name", "Name", Column::kPackage, 1},
-      {"x", "X", Column::kX, 0},
-      {"centerx", "Center X", Column::kX, 0},
-      {"y", "Y", Column::kY, 0},
-      {"centery", "Center Y", Column::kY, 0},
-      {"rotate", "Rotate", Column::kRotation, 0},
-      {"rotation", "Rotation", Column::kRotation, 0},
-      {"side", "Side", Column::kSide, 0},
-      {"dnp", "DNP", Column::kDnp, 0},
-  };
-  dialect.required = Required({Column::kDesignator, Column::kX, Column::kY, Column::kRotation});
+  dialect.aliases = MakeAliases({{Column::kDesignator, {"RefDes"}},
+                                 {Column::kValue, {"Value"}},
+                                 {Column::kPackage, {"Pattern", "Name"}},
+                                 {Column::kX, {"X|Center X"}},
+                                 {Column::kY, {"Y|Center Y"}},
+                                 {Column::kRotation, {"Rotate|Rotation"}},
+                                 {Column::kSide, {"Side"}},
+                                 {Column::kDnp, {"DNP"}}});
+  dialect.required = RequiredColumns({Column::kDesignator, Column::kX, Column::kY, Column::kRotation});
   return dialect;
 }
 

@@ -6,6 +6,7 @@
 // and otherwise the first line with content, as a header:
 //   Ref .. PosX (separated by blanks: .pos without its '#', else CSV) -> KiCad
 //   RefDes .. X / Center X                                          -> DipTrace
+//   Designator .. Mid X, Ref X, Pad X and Layer (not TB), delimited -> EasyEDA
 //   Designator .. with Center-X, Ref X, Pad X or TB, or separated
 //     by blanks                                                     -> Altium
 //   Designator .. Mid X / PosX                                      -> JLCPCB CPL
@@ -55,6 +56,12 @@ std::optional<Format> FromHeaderLine(const Lines& lines, std::uint32_t number, c
   if (Names(fields, {"ref"}) && Names(fields, {"posx"})) return blanks ? Format::kKicadPos : Format::kKicadCsv;
   if (Names(fields, {"refdes"}) && Names(fields, {"x", "centerx"})) return Format::kDipTrace;
   if (Names(fields, {"designator"})) {
+    // EasyEDA keeps Protel's Mid/Ref/Pad columns with a Layer column (Altium's
+    // older reports have TB instead), separated by tabs.
+    if (!blanks && Names(fields, {"midx"}) && Names(fields, {"refx"}) && Names(fields, {"padx"}) &&
+        Names(fields, {"layer"})) {
+      return Format::kEasyEda;
+    }
     bool altium_names = Names(fields, {"centerx", "refx", "padx", "tb"});
     if (blanks || altium_names) return Format::kAltium;
     if (Names(fields, {"midx", "posx"})) return Format::kJlcpcb;

@@ -5,12 +5,15 @@
 //
 // The families, one reader file each:
 //   cad_kicad.cpp   KiCad ASCII .pos (both header generations, mm or inch) and KiCad CSV
-//   cad_altium.cpp  Altium pick-and-place reports, text and CSV, both generations
+//   cad_altium.cpp  Altium pick-and-place reports, text and CSV, both generations, and
+//                   EasyEDA's (Protel's Mid/Ref/Pad layout, UTF-16 with tabs)
 //   cad_csv.cpp     JLCPCB CPL / Fabrication Toolkit, DipTrace 3.x and 4.x, generic CSV
 //   cad_eagle.cpp   Eagle mountsmd .mnt/.mnb (no header)
 // The header-driven families share the table reader in cad_table.cpp;
 // cad_detect.cpp tells the formats apart; cad_text.cpp splits and reads
-// fields. Every data row becomes a Row or a diagnostic at its line.
+// fields; cad_encoding.cpp decodes UTF-16 and Windows-1252 lists first;
+// cad_bottom.cpp decides how a list writes its bottom side. Every data row
+// becomes a Row or a diagnostic at its line.
 #pragma once
 
 #include <array>
@@ -20,6 +23,7 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "frontend/cad/cad_encoding.h"
 #include "frontend/cad/cad_row.h"
 
 namespace smtcal::cad {
@@ -42,6 +46,16 @@ struct ReadOptions {
   std::optional<char> delimiter;    // nullopt: from the header line (',', ';', tab, or blanks)
   ColumnMapping mapping;            // kGenericCsv only
   Side side_without_column = Side::kTop;  // the side of rows when the list has no side column
+  bool skip_empty_designators = false;    // a row without a designator: a warning and skipped, not an error
+};
+
+// What a list's preamble says about the tool that wrote it: KiCad's
+// "### Printed by Pcbnew version 6.0.11" (the bottom-side convention
+// depends on it, docs/import.md).
+struct ToolVersion {
+  std::string text;   // "6.0.11+dfsg-1" as written; empty when the list names none
+  int major = 0;      // 6; 0 when unknown
+  SourceRange range;  // where the list says so
 };
 
 class ListReader {
@@ -56,6 +70,9 @@ class ListReader {
   LengthUnit unit() const { return unit_; }  // the list's length unit
   std::size_t rows_read() const { return rows_read_; }
   std::size_t rows_with_errors() const { return rows_with_errors_; }
+  // Rows left out for having no designator (ReadOptions::skip_empty_designators).
+  std::size_t rows_without_designator() const { return rows_without_designator_; }
+  const ToolVersion& tool_version() const { return tool_version_; }
 
  protected:
   explicit ListReader(Format format) : format_(format) {}
@@ -63,7 +80,15 @@ class ListReader {
   LengthUnit unit_ = LengthUnit::kMm;
   std::size_t rows_read_ = 0;
   std::size_t rows_with_errors_ = 0;
+  std::size_t rows_without_designator_ = 0;
+  ToolVersion tool_version_;
 };
+
+// Decodes the list registered as `file` to UTF-8 (cad_encoding.h): the id
+// of the decoded text (`file` itself when it is UTF-8 already), or nullopt
+// after reporting why it cannot be decoded. `encoding` tells which it was.
+std::optional<std::uint32_t> DecodeList(std::uint32_t file, SourceManager& sources, Diagnostics& diags,
+                                        TextEncoding& encoding);
 
 // Opens the list registered as `file` in diags.sources(). Returns null after
 // reporting why when the list cannot be read at all (unknown format, no

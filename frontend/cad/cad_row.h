@@ -19,6 +19,7 @@ enum class Format {
   kKicadPos,    // KiCad ASCII .pos ("Module positions" / "Footprint positions")
   kKicadCsv,    // KiCad CSV: Ref,Val,Package,PosX,PosY,Rot,Side
   kJlcpcb,      // JLCPCB CPL and the KiCad Fabrication Toolkit's CSV
+  kEasyEda,     // EasyEDA pick and place (UTF-16, tabs): Designator Footprint Mid X .. Layer Rotation Comment
   kAltium,      // Altium pick-and-place report, text or CSV, both generations
   kEagle,       // Eagle mountsmd.ulp .mnt/.mnb
   kDipTrace,    // DipTrace 3.x and 4.x CSV
@@ -26,8 +27,8 @@ enum class Format {
 };
 
 // The --format names, in the order of the enum.
-inline constexpr std::string_view kFormatNames[] = {"kicad-pos", "kicad-csv", "jlcpcb", "altium",
-                                                    "eagle",     "diptrace",  "csv"};
+inline constexpr std::string_view kFormatNames[] = {"kicad-pos", "kicad-csv", "jlcpcb",   "easyeda",
+                                                    "altium",    "eagle",     "diptrace", "csv"};
 std::string_view FormatName(Format format);
 // A person's name for the format: "KiCad .pos", "JLCPCB CPL", ...
 std::string_view FormatTitle(Format format);
@@ -39,6 +40,12 @@ double MmPer(LengthUnit unit);               // 1, 0.0254, 25.4
 
 enum class Side { kTop, kBottom };
 std::string_view SideName(Side side);  // top | bottom
+
+// How a list writes the x of its bottom-side parts: as seen from the top
+// through the board (most tools), or negated, as seen from the bottom
+// (KiCad 6 and older always; KiCad 7 and later when "negative X" is asked
+// for). Rotations are a separate matter (BottomRotation in cad_to_program.h).
+enum class BottomPositions { kTopView, kNegatedX };
 
 // Which column of a list a field plays; also the --columns keys.
 enum class Column { kDesignator, kValue, kPackage, kX, kY, kRotation, kSide, kDnp };

@@ -90,6 +90,7 @@ class TableReader final : public ListReader {
       return false;
     }
     ReadUnits();
+    tool_version_ = preamble_.version;
     decimal_comma_ = delimiter_ != ',';
     next_line_ = header_line_ + 1;
     return true;
@@ -109,8 +110,13 @@ class TableReader final : public ListReader {
       }
       ++rows_read_;
       const std::size_t errors_before = diags_.error_count();
+      skipped_row_ = false;
       if (split && FitFields(number) && ReadRow(number, row) && diags_.error_count() == errors_before) {
         return true;
+      }
+      if (skipped_row_ && diags_.error_count() == errors_before) {
+        ++rows_without_designator_;
+        continue;
       }
       ++rows_with_errors_;
     }
@@ -140,7 +146,7 @@ class TableReader final : public ListReader {
     std::vector<Field> fields;
     Diagnostics quiet(diags_.sources());  // lines before the header are not held to CSV rules
     for (std::uint32_t number = 1; number <= lines_.count(); ++number) {
-      if (dialect_.preamble != nullptr && !dialect_.preamble(lines_, number, stated_, diags_)) return false;
+      if (dialect_.preamble != nullptr && !dialect_.preamble(lines_, number, preamble_, diags_)) return false;
       if (dialect_.hash_header && SplitHashHeader(number, fields, quiet) && IsHeader(fields)) {
         return TakeHeader(number, ' ', fields);
       }
@@ -219,7 +225,7 @@ class TableReader final : public ListReader {
 
   // The list's own unit (preamble or column names) against --units.
   void ReadUnits() {
-    std::optional<StatedUnit> stated = stated_;
+    std::optional<StatedUnit> stated = preamble_.unit;
     for (int c : {static_cast<int>(Column::kX), static_cast<int>(Column::kY)}) {
       if (column_unit_[c] && !stated) stated = StatedUnit{*column_unit_[c], column_unit_range_[c]};
     }
@@ -287,7 +293,12 @@ class TableReader final : public ListReader {
     Text(Column::kPackage, row.package, row.package_range, number);
     bool ok = true;
     if (row.designator.empty()) {
-      diags_.Report(DiagKind::CadEmptyDesignator, row.designator_range);
+      if (options_.skip_empty_designators) {
+        diags_.Report(DiagKind::CadSkippedEmptyDesignator, RowRange(lines_, number));
+        skipped_row_ = true;
+      } else {
+        diags_.Report(DiagKind::CadEmptyDesignator, row.designator_range);
+      }
       ok = false;
     }
     std::optional<double> x = LengthOf(Column::kX), y = LengthOf(Column::kY);
@@ -340,7 +351,8 @@ class TableReader final : public ListReader {
   Dialect dialect_;
   ReadOptions options_;
   Diagnostics& diags_;
-  std::optional<StatedUnit> stated_;
+  Preamble preamble_;
+  bool skipped_row_ = false;  // the row just read was left out (no designator), not wrong
   std::uint32_t header_line_ = 0;
   std::uint32_t next_line_ = 1;
   char delimiter_ = ',';
@@ -355,6 +367,28 @@ class TableReader final : public ListReader {
 };
 
 }  // namespace
+
+std::vector<ColumnAlias> MakeAliases(std::initializer_list<ColumnNames> names) {
+  std::vector<ColumnAlias> aliases;
+  for (const ColumnNames& column : names) {
+    for (std::size_t rank = 0; rank < column.ranked.size(); ++rank) {
+      std::string_view equal = column.ranked[rank];
+      while (!equal.empty()) {
+        std::size_t bar = std::min(equal.find('|'), equal.size());
+        std::string_view display = equal.substr(0, bar);
+        aliases.push_back({NormaliseColumnName(display).base, std::string(display), column.column, static_cast<int>(rank)});
+        equal.remove_prefix(std::min(bar + 1, equal.size()));
+      }
+    }
+  }
+  return aliases;
+}
+
+std::array<bool, kColumnCount> RequiredColumns(std::initializer_list<Column> columns) {
+  std::array<bool, kColumnCount> required{};
+  for (Column c : columns) required[static_cast<int>(c)] = true;
+  return required;
+}
 
 bool MentionsColumn(const std::vector<Field>& fields, const std::vector<ColumnAlias>& aliases, Column column) {
   for (const Field& field : fields) {

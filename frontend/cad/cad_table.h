@@ -26,10 +26,27 @@ struct ColumnAlias {
   int rank = 0;  // when a header has two names for one column, the lower rank wins
 };
 
+// The names a column goes by in one family, best first: each entry is one
+// name or several of equal rank separated by '|' ("Center-X|Mid X"); a
+// later entry is used only when the header has none of the earlier ones.
+struct ColumnNames {
+  Column column;
+  std::vector<std::string_view> ranked;
+};
+std::vector<ColumnAlias> MakeAliases(std::initializer_list<ColumnNames> names);
+// The columns a header must have.
+std::array<bool, kColumnCount> RequiredColumns(std::initializer_list<Column> columns);
+
 // What a preamble line said about the list's unit.
 struct StatedUnit {
   LengthUnit unit = LengthUnit::kMm;
   SourceRange range;  // where the list says so
+};
+
+// What the preamble lines said: the unit, the tool's version.
+struct Preamble {
+  std::optional<StatedUnit> unit;
+  ToolVersion version;
 };
 
 struct Dialect {
@@ -38,10 +55,9 @@ struct Dialect {
   std::array<bool, kColumnCount> required{};  // columns a header must have
   bool hash_header = false;  // the header line starts with '#' (KiCad .pos)
   bool fixed_width = false;  // rows whose blank-separated fields do not fit are cut at the header's columns (Altium text)
-  // Reads a line before the header; may state the unit. Returns false after
-  // reporting a mistake.
-  bool (*preamble)(const Lines& lines, std::uint32_t number, std::optional<StatedUnit>& unit,
-                   Diagnostics& diags) = nullptr;
+  // Reads a line before the header; may state the unit or the tool's
+  // version. Returns false after reporting a mistake.
+  bool (*preamble)(const Lines& lines, std::uint32_t number, Preamble& preamble, Diagnostics& diags) = nullptr;
   // Generic CSV given by column numbers: no header, 0-based field index per
   // column (-1 = not mapped).
   std::optional<std::array<int, kColumnCount>> fixed_columns;
@@ -58,6 +74,7 @@ Dialect KicadPosDialect();
 Dialect KicadCsvDialect();
 Dialect AltiumDialect();
 Dialect JlcpcbDialect();
+Dialect EasyEdaDialect();
 Dialect DipTraceDialect();
 Dialect GenericDialect(const ColumnMapping& mapping);
 

@@ -128,7 +128,7 @@ void TrimInPlace(std::string& text) {
 }  // namespace
 
 bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, std::vector<Field>& fields,
-                    Diagnostics& diags) {
+                    Diagnostics& diags, bool multiline) {
   std::size_t count = 0;
   std::string_view line = lines.Text(number);
   std::size_t i = 0;
@@ -144,6 +144,11 @@ bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, s
       while (true) {
         if (i >= line.size()) {
           // RFC 4180: a line end inside quotes belongs to the field.
+          if (!multiline) {
+            diags.Report(DiagKind::CsvUnclosedQuote, lines.Range(begin_line, begin, 1));
+            fields.resize(count);
+            return false;
+          }
           if (number >= lines.count()) {
             diags.Report(DiagKind::CadUnclosedQuote, lines.Range(begin_line, begin, 1));
             fields.resize(count);
@@ -446,6 +451,100 @@ bool GlobMatch(std::string_view pattern, std::string_view text) {
   return p == pattern.size();
 }
 
+// ------------------------------------------------------------------ packages
+
+namespace {
+
+// Chip sizes, imperial code (inch/100) and metric code (mm/10).
+struct ChipSizeCode {
+  std::string_view imperial;
+  std::string_view metric;
+};
+constexpr ChipSizeCode kChipSizes[] = {
+    {"01005", "0402"}, {"0201", "0603"}, {"0402", "1005"}, {"0603", "1608"}, {"0805", "2012"},
+    {"1008", "2520"},  {"1206", "3216"}, {"1210", "3225"}, {"1806", "4516"}, {"1812", "4532"},
+    {"1825", "4564"},  {"2010", "5025"}, {"2220", "5750"}, {"2512", "6332"},
+};
+
+// IPC-7351 land pattern families whose names go on with the metric size:
+// CAPC2012X135N, RESC1005X40N, INDC3225X...
+constexpr std::string_view kIpcFamilies[] = {"capc", "capm", "capmp", "resc", "resm", "indc", "indm", "indp",
+                                             "dioc", "diom", "ledc", "ledm", "fusc", "fusm"};
+
+// Runs of letters and runs of digits, lower case; everything else splits.
+std::vector<std::string> NameTokens(std::string_view name) {
+  std::vector<std::string> tokens;
+  auto kind = [](char c) {
+    if (c >= '0' && c <= '9') return 1;
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z')) return 2;
+    return 0;
+  };
+  for (std::size_t i = 0; i < name.size();) {
+    int k = kind(name[i]);
+    if (k == 0) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < name.size() && kind(name[end]) == k) ++end;
+    tokens.push_back(AsciiLowercase(name.substr(i, end - i)));
+    i = end;
+  }
+  return tokens;
+}
+
+std::string_view ImperialFromMetric(std::string_view metric) {
+  for (const ChipSizeCode& size : kChipSizes) {
+    if (size.metric == metric) return size.imperial;
+  }
+  return {};
+}
+
+// The size a feeder's pattern names: "0805", "2012Metric" -> "0805".
+std::string_view PatternSize(std::string_view pattern) {
+  for (const ChipSizeCode& size : kChipSizes) {
+    if (size.imperial == pattern) return size.imperial;
+  }
+  std::string lower = AsciiLowercase(pattern);
+  if (lower.size() > 6 && lower.ends_with("metric")) return ImperialFromMetric(std::string_view(pattern).substr(0, lower.size() - 6));
+  return {};
+}
+
+std::string WithoutSeparators(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    if (c != '-' && c != '_' && c != ' ') out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view ChipSize(std::string_view package) {
+  std::vector<std::string> tokens = NameTokens(package);
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    const std::string& token = tokens[i];
+    if (token.size() < 4 || token.size() > 5 || token.front() < '0' || token.front() > '9') continue;
+    const bool before_metric = i + 1 < tokens.size() && tokens[i + 1] == "metric";
+    const bool after_family = i > 0 && std::find(std::begin(kIpcFamilies), std::end(kIpcFamilies), tokens[i - 1]) !=
+                                           std::end(kIpcFamilies);
+    if (before_metric || after_family) {
+      if (std::string_view imperial = ImperialFromMetric(token); !imperial.empty()) return imperial;
+      continue;
+    }
+    for (const ChipSizeCode& size : kChipSizes) {
+      if (size.imperial == token) return size.imperial;
+    }
+  }
+  return {};
+}
+
+bool PackageMatch(std::string_view pattern, std::string_view package) {
+  if (std::string_view size = PatternSize(pattern); !size.empty()) return ChipSize(package) == size;
+  return GlobMatch(WithoutSeparators(pattern), WithoutSeparators(package));
+}
+
 // ------------------------------------------------------------------ names
 
 std::string_view FormatName(Format format) { return kFormatNames[static_cast<int>(format)]; }
@@ -455,6 +554,7 @@ std::string_view FormatTitle(Format format) {
     case Format::kKicadPos: return "KiCad .pos";
     case Format::kKicadCsv: return "KiCad CSV";
     case Format::kJlcpcb: return "JLCPCB CPL";
+    case Format::kEasyEda: return "EasyEDA pick and place";
     case Format::kAltium: return "Altium pick and place";
     case Format::kEagle: return "Eagle mountsmd";
     case Format::kDipTrace: return "DipTrace";

@@ -53,11 +53,14 @@ struct Field {
 };
 
 // Splits a delimited record starting on line `number` (RFC 4180: a field in
-// double quotes may hold the delimiter, "" for a quote, and line ends; then
-// the record runs on to later lines and `number` is advanced to its last
-// line). Returns false after reporting a quoting error.
+// double quotes may hold the delimiter and "" for a quote). With
+// `multiline`, a quoted field may hold line ends too: the record then runs
+// on to later lines and `number` is advanced to its last line (CAD lists);
+// without it a quoted field ends on its own line (the error tables' CSV,
+// frontend/table_csv.h, which splits its lines here too). Returns false
+// after reporting a quoting error.
 bool SplitDelimited(const Lines& lines, std::uint32_t& number, char delimiter, std::vector<Field>& fields,
-                    Diagnostics& diags);
+                    Diagnostics& diags, bool multiline = true);
 // Splits a line at runs of spaces and tabs; a field that starts with '"'
 // runs to the closing quote and may hold spaces (Altium's descriptions).
 bool SplitWhitespace(const Lines& lines, std::uint32_t number, std::vector<Field>& fields, Diagnostics& diags);
@@ -112,5 +115,21 @@ ColumnName NormaliseColumnName(std::string_view name);
 // Case-insensitive glob match: '*' any run, '?' one code point; the rest
 // compared ASCII-case-insensitively.
 bool GlobMatch(std::string_view pattern, std::string_view text);
+
+// A feeder's package pattern against a package as CAD tools write it
+// (docs/import.md, "Feeders"):
+//   - a chip size code ("0805", "0402", "01005", or metric "2012Metric")
+//     matches every package of that size, however the tool spells it:
+//     KiCad's C_0805_2012Metric, EasyEDA's C0805, Altium's 0805 and IPC-7351
+//     names such as CAPC2012X135N or RESC2012X65N (metric sizes after an
+//     IPC family, or before "Metric"); "0603" is the imperial 0603 and never
+//     the metric one (C_0201_0603Metric is an 0201);
+//   - anything else is a glob (GlobMatch) in which '-', '_' and spaces do
+//     not count, so "SOT-23" matches SOT23 and SOT_23, "C_0805*" C0805.
+bool PackageMatch(std::string_view pattern, std::string_view package);
+
+// The imperial chip size a package name holds ("0805" for
+// C_0805_2012Metric and CAPC2012X135N), or "" when it names none.
+std::string_view ChipSize(std::string_view package);
 
 }  // namespace smtcal::cad

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <unordered_map>
@@ -21,6 +22,7 @@
 #include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
+#include "frontend/cad/cad_bottom.h"
 #include "frontend/cad/cad_text.h"
 
 namespace smtcal {
@@ -151,13 +153,18 @@ class NameTable {
   }
 
   // `wanted` if free, else wanted_2, wanted_3, ...; `taken_by` tells who
-  // had `wanted`.
+  // had `wanted`. The next suffix to try is kept per wanted name, so n
+  // parts with one designator cost n claims, not n^2 / 2.
   std::string Claim(const std::string& wanted, NameOwner owner, std::optional<NameOwner>* taken_by = nullptr) {
     if (const NameOwner* existing = Insert(wanted, owner)) {
       if (taken_by != nullptr) *taken_by = *existing;
-      for (int k = 2;; ++k) {
+      int& next = next_suffix_[AsciiLowercase(wanted)];
+      for (int k = std::max(next, 2);; ++k) {
         std::string name = fmt::format("{}_{}", wanted, k);
-        if (Insert(name, owner) == nullptr) return name;
+        if (Insert(name, owner) == nullptr) {
+          next = k + 1;
+          return name;
+        }
       }
     }
     return wanted;
@@ -170,16 +177,15 @@ class NameTable {
     NameOwner owner;
   };
 
-  static char AsciiLowercase(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
   static std::size_t Hash(std::string_view name) {
     std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
-    for (char c : name) hash = (hash ^ static_cast<unsigned char>(AsciiLowercase(c))) * 1099511628211ull;
+    for (char c : name) hash = (hash ^ static_cast<unsigned char>(AsciiLower(c))) * 1099511628211ull;
     return static_cast<std::size_t>(hash);
   }
   static bool Same(std::string_view a, std::string_view b) {
     if (a.size() != b.size()) return false;
     for (std::size_t i = 0; i < a.size(); ++i) {
-      if (AsciiLowercase(a[i]) != AsciiLowercase(b[i])) return false;
+      if (AsciiLower(a[i]) != AsciiLower(b[i])) return false;
     }
     return true;
   }
@@ -211,6 +217,7 @@ class NameTable {
 
   std::vector<std::uint32_t> slots_;
   std::vector<Entry> entries_;
+  std::unordered_map<std::string, int> next_suffix_;  // per wanted name (lower case): the suffix to try first
 };
 
 // 'text' for a message, or "none" when the list gives none.
@@ -250,6 +257,7 @@ std::string_view SkipReasonName(SkipReason reason) {
     case SkipReason::kDnp: return "do-not-place";
     case SkipReason::kExcluded: return "excluded";
     case SkipReason::kUnmapped: return "no feeder";
+    case SkipReason::kNoDesignator: return "no designator";
     case SkipReason::kCount: break;
   }
   return "?";
@@ -259,6 +267,10 @@ std::string FormatImportSummary(const ImportSummary& s) {
   std::string text = fmt::format("import: {} row{} read ({})", s.rows_read, s.rows_read == 1 ? "" : "s", s.format);
   if (s.rows_with_errors > 0) text += fmt::format(", {} with errors", s.rows_with_errors);
   text += '\n';
+  if (s.encoding == cad::TextEncoding::kWindows1252) {
+    text += "  note:    the list is not UTF-8, so it was read as Windows-1252 (as Altium on Windows writes it);\n"
+            "           check that its letters beyond ASCII (µ, °, ±) read right in the program's comments\n";
+  }
   if (s.failed) {
     text += "  placed:  nothing (see the errors above)\n";
   } else {
@@ -274,6 +286,7 @@ std::string FormatImportSummary(const ImportSummary& s) {
     reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", s.skipped[r], SkipReasonName(static_cast<SkipReason>(r)));
   }
   text += fmt::format("  skipped: {}{}\n", skipped, reasons.empty() ? "" : " (" + reasons + ")");
+  if (!s.bottom.empty()) text += fmt::format("  bottom:  {}\n", s.bottom);
   return text;
 }
 
@@ -389,7 +402,12 @@ void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
 std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   summary_.rows_read = reader.rows_read();
   summary_.rows_with_errors = reader.rows_with_errors();
+  summary_.skipped[static_cast<int>(SkipReason::kNoDesignator)] = reader.rows_without_designator();
   summary_.format = fmt::format("{}, {}", cad::FormatTitle(reader.format()), cad::UnitName(reader.unit()));
+  summary_.encoding = options_.encoding;
+  if (options_.encoding != cad::TextEncoding::kUtf8) {
+    summary_.format += fmt::format(", {} text", cad::EncodingName(options_.encoding));
+  }
   const SourceRange list_start(SourceLoc{list_file_, 1, 1});
 
   // The side: as asked, or the only one the list places parts on.
@@ -433,12 +451,16 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
       diags_.Report(DiagKind::CadNoRows, list_start, cad::FormatTitle(reader.format()));
     } else if (summary_.rows_with_errors == 0) {
       std::size_t rows = summary_.rows_read;
-      diags_.Report(DiagKind::ImportNothingToPlace, list_start, rows, rows == 1 ? "row" : "rows");
+      // About the whole list, so it is printed after the skips it sums up.
+      diags_.Report(DiagKind::ImportNothingToPlace, SourceRange(SourceLoc{list_file_, 0, 0}), rows,
+                    rows == 1 ? "row" : "rows");
     }
     summary_.failed = true;
     return std::nullopt;
   }
-  std::optional<ir::Program> program = Build(placed, side);
+  cad::BottomPositions bottom_positions = cad::BottomPositions::kTopView;
+  if (side == cad::Side::kBottom) bottom_positions = DescribeBottom(reader);
+  std::optional<ir::Program> program = Build(placed, side, bottom_positions);
   std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
   if (!program || diags_.has_errors()) {
     summary_.failed = true;
@@ -447,7 +469,95 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   return program;
 }
 
-std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side) {
+cad::BottomPositions CadImporter::DescribeBottom(const cad::ListReader& reader) {
+  cad::BottomPositions positions;
+  std::string why;
+  if (options_.bottom_positions) {
+    positions = *options_.bottom_positions;
+    why = "as --bottom-positions says";
+  } else {
+    std::vector<cad::SidedX> sided;
+    sided.reserve(parts_.size());
+    for (const Part& part : parts_) sided.push_back({part.x_mm, part.side});
+    cad::BottomDecision decision = cad::DecideBottomPositions(reader, sided);
+    positions = decision.positions;
+    why = decision.why;
+  }
+  const ImportMirror mirror = options_.mirror.value_or(ImportMirror::kX);
+  const bool negated = positions == cad::BottomPositions::kNegatedX;
+  const bool top_view_rotation = options_.bottom_rotation == BottomRotation::kTopView;
+  // The program's x, y and u from the list's, in the list's own numbers.
+  std::string x = (mirror == ImportMirror::kX) != negated ? "x' = -x" : "x' = x";
+  std::string y = mirror == ImportMirror::kY ? ", y' = -y" : "";
+  std::string u = mirror == ImportMirror::kNone || !top_view_rotation ? "u = rotation"
+                  : mirror == ImportMirror::kX                        ? "u = 180° - rotation"
+                                                                      : "u = -rotation";
+  summary_.bottom = fmt::format(
+      "x as seen from the {}: {}\n           rotations as seen from the {}; {}: {}{}, {}",
+      negated ? "bottom (negated)" : "top", why, top_view_rotation ? "top" : "bottom",
+      mirror == ImportMirror::kX   ? "the board turned over about its y axis"
+      : mirror == ImportMirror::kY ? "the board turned over about its x axis"
+                                   : "the board not turned over (--mirror none)",
+      x, y, u);
+  return positions;
+}
+
+void CadImporter::PlaceOnSpot(const std::vector<std::array<double, 2>>& on_board, double angle) {
+  // The parts of the whole panel in the panel's own axes: board (c, r) is
+  // (c * pitch_x, r * pitch_y) from the first.
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
+  for (const auto& [x, y] : on_board) {
+    lo_x = std::min(lo_x, x);
+    hi_x = std::max(hi_x, x + (options_.columns - 1) * options_.pitch_x_mm);
+    lo_y = std::min(lo_y, y);
+    hi_y = std::max(hi_y, y + (options_.rows - 1) * options_.pitch_y_mm);
+  }
+  const double cx = (lo_x + hi_x) / 2, cy = (lo_y + hi_y) / 2;
+  const auto [spot_x, spot_y] = *options_.centre_spot;
+  options_.origin_x_mm = Round(spot_x - (std::cos(angle) * cx - std::sin(angle) * cy), kCadResolutionMm);
+  options_.origin_y_mm = Round(spot_y - (std::sin(angle) * cx + std::cos(angle) * cy), kCadResolutionMm);
+}
+
+std::vector<std::unordered_map<std::size_t, int>> CadImporter::AssignTapeLanes(
+    const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder) {
+  const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
+  std::vector<std::unordered_map<std::size_t, int>> lane_of(feeders.size());
+  for (std::size_t f = 0; f < feeders.size(); ++f) {
+    const cad::FeederSpec& feeder = feeders[f];
+    if (by_feeder[f].empty() || feeder.kind != cell::FeederKind::kTape || feeder.lanes_by_package()) continue;
+    // One kind of part (package and value) per tape, lanes in the order the
+    // kinds first appear in the list; a lane a [[map]] gives is kept.
+    std::map<std::pair<std::string, std::string>, int> lanes;
+    const Part* first = nullptr;
+    for (std::size_t i : by_feeder[f]) {
+      const Part& part = *parts[i];
+      if (part.feeder->lane) continue;
+      auto [it, fresh] = lanes.emplace(std::make_pair(part.package, part.value), static_cast<int>(lanes.size()) + 1);
+      if (first == nullptr) first = &part;
+      if (!fresh) {
+        if (feeder.is_pallet()) lane_of[f][i] = it->second;
+        continue;
+      }
+      if (!feeder.is_pallet()) {
+        if (it->second == 2) {
+          diags_.Report(DiagKind::ImportTapeMixedKinds, part.designator_range, Printable(feeder.name),
+                        Quoted(part.package), Quoted(part.value), Printable(first->designator),
+                        Quoted(first->package), Quoted(first->value));
+        }
+        continue;
+      }
+      if (it->second == feeder.pick_points() + 1) {
+        diags_.Report(DiagKind::ImportTapeLanesFull, part.designator_range, Printable(feeder.name),
+                      feeder.pick_points(), Quoted(part.package), Quoted(part.value), it->second);
+      }
+      lane_of[f][i] = it->second;
+    }
+  }
+  return lane_of;
+}
+
+std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& parts, cad::Side side,
+                                              cad::BottomPositions bottom_positions) {
   const SourceLoc start{list_file_, 1, 1};
   const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
   NameTable names(parts.size() * static_cast<std::size_t>(options_.columns) * static_cast<std::size_t>(options_.rows) +
@@ -464,11 +574,29 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   items.push_back(MakeStmt(start, ir::FixtureDecl{options_.fixture, start}));
   items.push_back(MakeStmt(start, ir::VacuumDecl{options_.vacuum, start}, " the gripper's vacuum output (--vacuum)"));
 
+  // --- where each part is on its board: x, y as the list gives them,
+  // turned over for the bottom side ---------------------------------------
+  const ImportMirror mirror = options_.mirror.value_or(side == cad::Side::kBottom ? ImportMirror::kX : ImportMirror::kNone);
+  const bool mirror_rotation =
+      mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
+  const bool list_negated = side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX;
+  std::vector<std::array<double, 2>> on_board(parts.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const double x_top = list_negated ? -parts[i]->x_mm : parts[i]->x_mm;  // the list's x as seen from the top
+    const double x = mirror == ImportMirror::kX ? -x_top : x_top;
+    const double y = mirror == ImportMirror::kY ? -parts[i]->y_mm : parts[i]->y_mm;
+    on_board[i] = {x == 0 ? 0.0 : x, y == 0 ? 0.0 : y};
+  }
+
   // --- the boards of the panel, row by row from the origin --------------
   const double angle = options_.rotation_deg * std::numbers::pi / 180.0;
+  if (!options_.origin_given && options_.centre_spot) PlaceOnSpot(on_board, angle);
+  summary_.origin_x_mm = options_.origin_x_mm;
+  summary_.origin_y_mm = options_.origin_y_mm;
   std::vector<std::string> boards;
   std::string board_text = fmt::format("origin ({}, {}) mm, rotated {}°", options_.origin_x_mm, options_.origin_y_mm,
                                        options_.rotation_deg);
+  if (!options_.origin_given && options_.centre_spot) board_text += ", its parts centred on " + options_.centre_spot_name;
   const bool panel = options_.columns * options_.rows > 1;
   items.push_back(CommentStmt(
       start,
@@ -493,6 +621,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   // --- the feeders the parts use, in the feeder table's order ------------
   std::vector<std::vector<std::size_t>> by_feeder(feeders.size());  // indices into parts
   for (std::size_t i = 0; i < parts.size(); ++i) by_feeder[parts[i]->feeder->feeder].push_back(i);
+  std::vector<std::unordered_map<std::size_t, int>> tape_lane = AssignTapeLanes(parts, by_feeder);
   std::vector<std::string> pick_name(feeders.size());  // a point, or empty for a pallet
   std::vector<int> pallet_number(feeders.size(), 0);
   int next_pallet = kFirstPallet;
@@ -539,12 +668,11 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   }
 
   // --- the parts, board by board -----------------------------------------
-  const ImportMirror mirror = options_.mirror.value_or(side == cad::Side::kBottom ? ImportMirror::kX : ImportMirror::kNone);
-  const bool mirror_rotation =
-      mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
-  std::string how = mirror == ImportMirror::kX   ? ", turned over: x negated"
-                    : mirror == ImportMirror::kY ? ", turned over: y negated"
-                                                 : "";
+  std::string how = mirror == ImportMirror::kX   ? (list_negated ? ", turned over: x as the list writes it (negated there)"
+                                                                 : ", turned over: x negated")
+                    : mirror == ImportMirror::kY ? (list_negated ? ", turned over: y negated, the list's negated x undone"
+                                                                 : ", turned over: y negated")
+                                                 : (list_negated ? ", the list's negated x undone" : "");
   std::vector<std::string> comments;  // per part: " C1 100n C_0603"
   comments.reserve(parts.size());
   for (const Part* part : parts) comments.push_back(" " + PartComment(*part));
@@ -573,13 +701,12 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         }
       }
       point_name[b][i] = name;
-      double x = mirror == ImportMirror::kX ? -part.x_mm : part.x_mm;
-      double y = mirror == ImportMirror::kY ? -part.y_mm : part.y_mm;
+      const auto [x, y] = on_board[i];
       double theta = part.rotation_deg;
       if (mirror_rotation) theta = mirror == ImportMirror::kX ? 180.0 - theta : -theta;
       double u = NormaliseAngle(theta + part.feeder->rotation_offset_deg, options_.angles);
       ir::PointDecl point{name, loc, false,
-                          MakeCoords(loc, {x == 0 ? 0.0 : x, y == 0 ? 0.0 : y, options_.place_z_mm, u}), boards[b], loc};
+                          MakeCoords(loc, {x, y, options_.place_z_mm, u}), boards[b], loc};
       items.push_back(MakeStmt(loc, std::move(point), comments[i]));
     }
   }
@@ -609,6 +736,8 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
           pick.target.base = ir::NamedPoint{pick_name[f], static_cast<std::uint32_t>(pick_name[f].size())};
         } else {
           int k = part->feeder->lane.value_or(0);
+          if (auto lane = tape_lane[f].find(i); k == 0 && lane != tape_lane[f].end()) k = lane->second;
+          const bool is_lane = k != 0;
           if (k == 0) {
             k = ++pockets_used[f];
             if (k == feeder.pick_points() + 1) {
@@ -618,8 +747,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
             }
           }
           pick.target.base = ir::PalletPoint{IntLit(loc, std::max(pallet_number[f], 0)), IntLit(loc, k), nullptr};
-          pick_comment = part->feeder->lane ? fmt::format(" lane {}", k)
-                                            : fmt::format(" pocket {} of {}", k, feeder.pick_points());
+          pick_comment = is_lane ? fmt::format(" lane {}", k) : fmt::format(" pocket {} of {}", k, feeder.pick_points());
         }
         cycle.body.push_back(MakeStmt(loc, std::move(pick), pick_comment));
         ir::PickPlace place;

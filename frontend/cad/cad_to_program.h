@@ -51,29 +51,39 @@ enum class AngleRange { kSigned, kPositive };
 struct ImportOptions {
   std::optional<cad::Side> side;  // nullopt: the only side the list has parts on
   std::optional<ImportMirror> mirror;  // nullopt: none for top, x for bottom
+  // nullopt: decided from the list (cad_bottom.h)
+  std::optional<cad::BottomPositions> bottom_positions;
   BottomRotation bottom_rotation = BottomRotation::kTopView;
   AngleRange angles = AngleRange::kSigned;
   double origin_x_mm = 0;  // the board origin in the fixture frame
   double origin_y_mm = 0;
+  // false: the origin was not given, so the parts (of the whole panel) are
+  // centred on `centre_spot` (a point of the fixture frame: the centre of
+  // the largest calibrated region on the fixture), or, without one, the
+  // origin is (0, 0); the summary says which.
+  bool origin_given = true;
+  std::optional<std::array<double, 2>> centre_spot;
+  std::string centre_spot_name;  // "region 'layer1'", for the program and the summary
   double rotation_deg = 0;  // the board's x axis against the fixture's
   int columns = 1;          // panel
   int rows = 1;
   double pitch_x_mm = 0;
   double pitch_y_mm = 0;
-  double place_z_mm = 0;  // z of the placements in the board frame
+  double place_z_mm = 0;  // z of the placements in the board frame (the robot z of the board's top)
   int vacuum = 8;         // the program's Vacuum output
   bool skip_unmapped = false;
   bool keep_dnp = false;
   bool default_excludes = true;  // FID*, *Fiducial*, *MountingHole* (docs/import.md)
   std::vector<std::string> exclude_designators;  // globs
   std::vector<std::string> exclude_packages;
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;  // what the list was decoded from (cad_encoding.h)
   std::string program_name;  // a valid name; the Program line
   std::string fixture;       // the cell fixture the board is on
   std::vector<std::string> header_lines;  // comment lines opening the program (what was imported, how)
 };
 
 // Why rows were not placed.
-enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kCount };
+enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kNoDesignator, kCount };
 std::string_view SkipReasonName(SkipReason reason);
 
 struct ImportSummary {
@@ -81,9 +91,16 @@ struct ImportSummary {
   std::size_t rows_with_errors = 0;
   std::size_t parts_placed = 0;  // rows placed (on each board of the panel)
   std::size_t boards = 1;
+  double origin_x_mm = 0;  // where the (first) board's origin went, in the fixture frame
+  double origin_y_mm = 0;
   std::size_t feeders_used = 0;
   std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
-  std::string format;  // "KiCad CSV, mm"
+  std::string format;  // "KiCad CSV, mm" (", Windows-1252 text" when it was decoded)
+  cad::TextEncoding encoding = cad::TextEncoding::kUtf8;
+  // How the bottom side was read, when it is placed: "x negated in the list
+  // (KiCad 6.0.11 writes them so (line 2)); rotations as seen from the top;
+  // turned over about the board's y axis".
+  std::string bottom;
   bool failed = false;  // errors stopped the import: nothing is placed
 };
 // "import: 12 rows read: 9 placed (x 4 boards = 36 placements, 3 feeders),
@@ -129,7 +146,17 @@ class CadImporter {
   std::optional<cad::FeederMatch> FindFeeder(const cad::Row& row);
   void ReportSkip(const Part& part, cad::Side placed_side);
   void ReportUnmapped(const std::vector<const Part*>& unmapped);
-  std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side);
+  // How the bottom side is read (option or cad_bottom.h); fills summary_.bottom.
+  cad::BottomPositions DescribeBottom(const cad::ListReader& reader);
+  // Tapes hold one kind of part (package and value): per feeder, the lane
+  // of each part (by index into `parts`) of a bank of tapes; warns about a
+  // single tape given several kinds.
+  // Sets the origin so the parts' centre lands on options_.centre_spot.
+  void PlaceOnSpot(const std::vector<std::array<double, 2>>& on_board, double angle);
+  std::vector<std::unordered_map<std::size_t, int>> AssignTapeLanes(
+      const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder);
+  std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side,
+                                   cad::BottomPositions bottom_positions);
 
   const cad::FeederTable& feeders_;
   ImportOptions options_;

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
 
@@ -189,6 +191,73 @@ TEST(CadImport, KicadCsvAndJlcpcbCplOfTheSameBoardGiveTheSamePlacements) {
   EXPECT_EQ(std::count_if(a.begin(), a.end(), [](const std::string& l) { return l.find("    Place ") == 0; }), 9);
   ExpectCleanAndCanonical(kicad.text);
   ExpectCleanAndCanonical(jlc.text);
+}
+
+// The lists KiCad 6 wrote itself (tests/golden/import-kicad, made by
+// import-data/generate_kicad_lists.py with pcbnew) against KiCad's own pad
+// positions (import-data/kicad-truth.csv): with the default options every
+// part is placed so that its library pads land on KiCad's pads once the
+// board is turned over about its y axis (bottom) or as they are (top).
+TEST(CadImport, KicadListsPlaceEveryPadWhereKicadPutIt) {
+  const fs::path kicad = fs::path(SMTCAL_SOURCE_DIR) / "tests" / "golden" / "import-kicad";
+  struct TruthPad {
+    std::string ref, side;
+    double library_x, library_y, board_x, board_y;
+  };
+  std::vector<TruthPad> truth;
+  {
+    std::istringstream in(test::ReadFileText(kData / "kicad-truth.csv"));
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::istringstream fields(line);
+      for (std::string item; std::getline(fields, item, ',');) f.push_back(item);
+      ASSERT_EQ(f.size(), 7u) << line;
+      truth.push_back({f[0], f[1], std::stod(f[3]), std::stod(f[4]), std::stod(f[5]), std::stod(f[6])});
+    }
+  }
+  ASSERT_GT(truth.size(), 30u);
+  struct Case {
+    std::string file;
+    std::string side;
+    double origin_x, origin_y;  // the list's origin in the truth's frame (the auxiliary origin is 0, 0)
+    double tolerance_mm;        // what the list's decimals allow
+  };
+  const std::vector<Case> cases = {
+      {"kicad6_bottom.pos", "bottom", 0, 0, 1e-4},      {"kicad6_csv_bottom.csv", "bottom", 0, 0, 1e-4},
+      {"kicad6_bottom_inch.pos", "bottom", 0, 0, 2e-3}, {"kicad6_top.pos", "top", 0, 0, 1e-4},
+      {"kicad6_all_page.pos", "bottom", -90, 140, 1e-4}, {"kicad8_bottom.pos", "bottom", 0, 0, 1e-4},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.file);
+    ImportOptions options;
+    options.side = c.side == "top" ? cad::Side::kTop : cad::Side::kBottom;
+    Imported r = Import(test::ReadFileText(kicad / c.file), options, kData / "kicad-feeders.toml", {}, c.file);
+    ASSERT_TRUE(r.program) << r.diagnostics;
+    std::map<std::string, std::array<double, 4>> placed;
+    for (const ir::StmtPtr& stmt : r.program->items) {
+      if (const auto* point = std::get_if<ir::PointDecl>(&stmt->node); point != nullptr && point->frame == "Pcb") {
+        placed[point->name] = point->coords.values;
+      }
+    }
+    std::size_t pads = 0;
+    for (const TruthPad& pad : truth) {
+      if (pad.side != c.side) continue;
+      ASSERT_TRUE(placed.count(pad.ref)) << pad.ref << " is not placed";
+      const auto& [x, y, z, u] = placed[pad.ref];
+      const double angle = u * std::numbers::pi / 180.0;
+      const double at_x = x + std::cos(angle) * pad.library_x - std::sin(angle) * pad.library_y;
+      const double at_y = y + std::sin(angle) * pad.library_x + std::cos(angle) * pad.library_y;
+      // KiCad's pad, in the list's frame, and seen from below for the bottom.
+      double want_x = pad.board_x - c.origin_x, want_y = pad.board_y - c.origin_y;
+      if (c.side == "bottom") want_x = -want_x;
+      EXPECT_NEAR(at_x, want_x, c.tolerance_mm) << pad.ref << " pad";
+      EXPECT_NEAR(at_y, want_y, c.tolerance_mm) << pad.ref << " pad";
+      ++pads;
+    }
+    EXPECT_GT(pads, 8u);
+  }
 }
 
 TEST(CadImport, FeederMatching) {

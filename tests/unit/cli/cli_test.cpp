@@ -77,6 +77,7 @@ TEST(Cli, OutputThatWouldOverwriteAnInputIsRefused) {
       {"table plot placing-table.csv -o placing-table.csv", "placing-table.csv"},
       {fmt::format("simulate layers.place --cell {} --cycles 1 --svg layers.place", cell), "layers.place"},
       {"diff layers.place layers.place --svg layers.place", "layers.place"},
+      {fmt::format("import placing-table.csv --cell {} -o placing-table.csv", cell), "placing-table.csv"},
   };
   for (const Case& c : cases) {
     SmtcalRun run = smtcal::test::RunSmtcal(c.args, dir);

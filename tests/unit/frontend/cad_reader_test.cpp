@@ -11,6 +11,8 @@
 
 #include "frontend/cad/cad_reader.h"
 #include "frontend/cad/cad_table.h"
+#include "frontend/cad/cad_bottom.h"
+#include "frontend/cad/cad_encoding.h"
 #include "frontend/cad/cad_text.h"
 
 namespace smtcal::cad {
@@ -54,6 +56,65 @@ std::optional<Format> Detect(const std::string& text) {
   return DetectFormat(Lines(sources, file), sources);
 }
 
+// Lists as their tools write them: UTF-16 by its byte order mark or its zero
+// bytes, Windows-1252 when the bytes are not UTF-8, UTF-8 kept as it is.
+TEST(CadEncoding, Utf16AndWindows1252AreDecodedAndOtherBytesRefused) {
+  const std::string utf8 = "Designator\tMid X\n\xC2\xB5" "F\n";  // "µF"
+  DecodedText kept = DecodeListText(utf8);
+  EXPECT_TRUE(kept.ok);
+  EXPECT_EQ(kept.encoding, TextEncoding::kUtf8);
+  EXPECT_EQ(kept.text, "");  // use the bytes as they are
+  std::string le = "\xFF\xFE", be = "\xFE\xFF", le_bare, be_bare;
+  for (unsigned char c : std::string("Designator\tMid X\n\xB5" "F\n")) {  // every code point below 256
+    le += {static_cast<char>(c), '\0'};
+    be += {'\0', static_cast<char>(c)};
+  }
+  le_bare = le.substr(2);
+  be_bare = be.substr(2);
+  for (const auto& [bytes, encoding] : std::initializer_list<std::pair<std::string, TextEncoding>>{
+           {le, TextEncoding::kUtf16Le}, {be, TextEncoding::kUtf16Be}, {le_bare, TextEncoding::kUtf16Le},
+           {be_bare, TextEncoding::kUtf16Be}}) {
+    DecodedText decoded = DecodeListText(bytes);
+    EXPECT_TRUE(decoded.ok) << EncodingName(encoding);
+    EXPECT_EQ(decoded.encoding, encoding);
+    EXPECT_EQ(decoded.text, utf8);
+  }
+  DecodedText windows = DecodeListText("C1 1\xB5" "F \xB1" "10%\n");
+  EXPECT_TRUE(windows.ok);
+  EXPECT_EQ(windows.encoding, TextEncoding::kWindows1252);
+  EXPECT_EQ(windows.text, "C1 1\xC2\xB5" "F \xC2\xB1" "10%\n");
+  DecodedText undefined = DecodeListText("C1 1\xB5" "F\nU1 \x81\n");
+  EXPECT_FALSE(undefined.ok);
+  EXPECT_EQ(undefined.bad_offset, 10u);
+  EXPECT_NE(undefined.why.find("0x81"), std::string::npos);
+  DecodedText cut = DecodeListText(le.substr(0, le.size() - 1));
+  EXPECT_FALSE(cut.ok);
+}
+
+// The version line of KiCad's .pos, which decides its bottom-side x.
+TEST(CadKicad, VersionFromThePrintedByLine) {
+  struct Case {
+    const char* line;
+    int major;
+  };
+  for (const Case& c : std::initializer_list<Case>{{"### Printed by Pcbnew version 6.0.11+dfsg-1", 6},
+                                                   {"### Printed by Pcbnew version kicad (5.1.9)-1", 5},
+                                                   {"### Printed by Pcbnew version kicad 4.0.5", 4},
+                                                   {"### Printed by KiCad version 8.0.3", 8},
+                                                   {"### Printed by KiCad version 10.0.0-rc1", 10},
+                                                   {"### Printed by Pcbnew version pcbnew (2014-01-24 BZR 4632)-product", 0}}) {
+    SourceManager sources;
+    Diagnostics diags(sources);
+    std::string text = fmt::format("### Module positions - created on x ###\n{}\n## Unit = mm, Angle = deg.\n"
+                                   "# Ref Val Package PosX PosY Rot Side\nC1 1 C0603 1 2 0 bottom\n## End\n",
+                                   c.line);
+    std::unique_ptr<ListReader> reader = OpenList(sources.Add("list.pos", text), {}, diags);
+    ASSERT_TRUE(reader) << diags.RenderText();
+    EXPECT_EQ(reader->tool_version().major, c.major) << c.line;
+    EXPECT_EQ(reader->tool_version().range.begin.line, c.major > 0 ? 2u : 0u);
+  }
+}
+
 TEST(CadDetect, EveryFormatByContent) {
   EXPECT_EQ(Detect("### Module positions - created on x ###\n## Unit = mm, Angle = deg.\n"), Format::kKicadPos);
   EXPECT_EQ(Detect("### Footprint positions - created on x ###\n"), Format::kKicadPos);
@@ -67,6 +128,8 @@ TEST(CadDetect, EveryFormatByContent) {
   EXPECT_EQ(Detect("\"Altium Designer Pick and Place Locations\"\n"), Format::kAltium);
   EXPECT_EQ(Detect("Date: 1\nUnits used: mm\n"), Format::kAltium);
   EXPECT_EQ(Detect("Designator Footprint Mid X Mid Y Ref X Ref Y Pad X Pad Y TB Rotation Comment\n"), Format::kAltium);
+  EXPECT_EQ(Detect("Designator\tFootprint\tMid X\tMid Y\tRef X\tRef Y\tPad X\tPad Y\tLayer\tRotation\tComment\n"),
+            Format::kEasyEda);
   EXPECT_EQ(Detect("RefDes,Name,Value,X (mm),Y (mm),Rotate,Side\n"), Format::kDipTrace);
   EXPECT_EQ(Detect("RefDes,Name,Value,Center X (mm),Center Y (mm),Rotation,Side\n"), Format::kDipTrace);
   EXPECT_EQ(Detect("C1 10.16 5.08 90 100n C0603\n"), Format::kEagle);
@@ -284,6 +347,36 @@ TEST(CadReaderProperty, RandomRowsSurviveEveryQuirk) {
       EXPECT_EQ(r.rows[i].side, expected[i].side);
     }
   }
+}
+
+
+// How the bottom side's x is read (cad_bottom.h): by KiCad's version where
+// the .pos names one up to 6, else by the list's own numbers, else seen
+// from the top; every other tool from the top.
+TEST(CadBottom, KicadVersionThenTheNumbersThenTopView) {
+  auto decide = [](const std::string& text, const std::vector<SidedX>& parts, const std::string& name = "list.pos") {
+    SourceManager sources;
+    Diagnostics diags(sources);
+    std::unique_ptr<ListReader> reader = OpenList(sources.Add(name, text), {}, diags);
+    EXPECT_TRUE(reader) << diags.RenderText();
+    return reader ? DecideBottomPositions(*reader, parts).positions : BottomPositions::kTopView;
+  };
+  const std::string kicad6 = "### Module positions - created on x ###\n### Printed by Pcbnew version 6.0.11\n"
+                             "## Unit = mm, Angle = deg.\n# Ref Val Package PosX PosY Rot Side\n";
+  const std::string kicad8 = "### Footprint positions - created on x ###\n### Printed by KiCad version 8.0.3\n"
+                             "## Unit = mm, Angle = deg.\n# Ref Val Package PosX PosY Rot Side\n";
+  const std::string csv = "Ref,Val,Package,PosX,PosY,Rot,Side\n";
+  const std::string jlc = "Designator,Mid X,Mid Y,Layer,Rotation\n";
+  const std::vector<SidedX> mixed = {{5, Side::kBottom}, {-5, Side::kBottom}};
+  const std::vector<SidedX> negative = {{-5, Side::kBottom}, {-7, Side::kBottom}, {3, Side::kTop}};
+  const std::vector<SidedX> top_negative = {{-5, Side::kBottom}, {-3, Side::kTop}};
+  EXPECT_EQ(decide(kicad6, mixed), BottomPositions::kNegatedX);  // KiCad 6 always negated
+  EXPECT_EQ(decide(kicad8, mixed), BottomPositions::kTopView);
+  EXPECT_EQ(decide(kicad8, negative), BottomPositions::kNegatedX);  // "negative X" was asked for
+  EXPECT_EQ(decide(csv, negative, "list.csv"), BottomPositions::kNegatedX);
+  EXPECT_EQ(decide(csv, top_negative, "list.csv"), BottomPositions::kTopView);  // the numbers do not tell
+  EXPECT_EQ(decide(csv, mixed, "list.csv"), BottomPositions::kTopView);
+  EXPECT_EQ(decide(jlc, negative, "list.csv"), BottomPositions::kTopView);  // not KiCad
 }
 
 }  // namespace

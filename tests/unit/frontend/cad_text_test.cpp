@@ -107,6 +107,48 @@ TEST(CadText, ColumnNamesLoseCaseSeparatorsAndUnit) {
   EXPECT_EQ(cm.unit_text, "cm");
 }
 
+// Packages as CAD tools write them against a feeder's package pattern.
+TEST(CadText, ChipSizesHoweverTheToolSpellsThem) {
+  struct Case {
+    const char* package;
+    const char* size;
+  };
+  for (const Case& c : std::initializer_list<Case>{
+           {"C_0805_2012Metric", "0805"},      // KiCad
+           {"R_0402_1005Metric", "0402"},      // KiCad
+           {"LED_0603_1608Metric", "0603"},    // KiCad
+           {"C_0201_0603Metric", "0201"},      // KiCad: the metric 0603 is an 0201
+           {"C0805", "0805"},                  // EasyEDA
+           {"R0603", "0603"},                  // EasyEDA
+           {"0805", "0805"},                   // Altium
+           {"CAPC2012X135N", "0805"},          // IPC-7351, metric size after the family
+           {"RESC1005X40X25NL05T05", "0402"},  // IPC-7351
+           {"INDC3225X220N", "1210"},          // IPC-7351
+           {"01005", "01005"},
+           {"SOT-23", ""},
+           {"SOIC-8_3.9x4.9mm_P1.27mm", ""},
+           {"LED_WS2812B_PLCC4_5.0x5.0mm_P3.2mm", ""},
+           {"FP-ERJ2R-IPC_B", ""},
+           {"MOLEX-53261-0471_V", ""},
+       }) {
+    EXPECT_EQ(ChipSize(c.package), c.size) << c.package;
+  }
+  EXPECT_TRUE(PackageMatch("0805", "C_0805_2012Metric"));
+  EXPECT_TRUE(PackageMatch("0805", "CAPC2012X135N"));
+  EXPECT_TRUE(PackageMatch("2012Metric", "R0805"));
+  EXPECT_TRUE(PackageMatch("2012metric", "0805"));
+  EXPECT_FALSE(PackageMatch("0603", "C_0201_0603Metric"));
+  EXPECT_FALSE(PackageMatch("0805", "C_0603_1608Metric"));
+  EXPECT_FALSE(PackageMatch("0805", "SOT-23"));
+  // Other patterns are globs in which '-', '_' and spaces do not count.
+  EXPECT_TRUE(PackageMatch("SOT-23", "SOT23"));
+  EXPECT_TRUE(PackageMatch("SOT-23", "sot_23"));
+  EXPECT_FALSE(PackageMatch("SOT-23", "SOT-23-5"));
+  EXPECT_TRUE(PackageMatch("C_0805*", "C0805"));
+  EXPECT_TRUE(PackageMatch("SOIC-8*", "SOIC-8_3.9x4.9mm_P1.27mm"));
+  EXPECT_FALSE(PackageMatch("SOIC-8*", "SOIC-14_3.9x8.7mm_P1.27mm"));
+}
+
 TEST(CadText, Globs) {
   EXPECT_TRUE(GlobMatch("R_0603*", "r_0603_1608Metric"));
   EXPECT_TRUE(GlobMatch("*", ""));

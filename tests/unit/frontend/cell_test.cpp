@@ -226,7 +226,9 @@ TEST(PaperCellFile, LoadsWithoutAnyDiagnostic) {
 
   ASSERT_EQ(cell.feeders.size(), 2u);
   EXPECT_EQ(cell.feeders[0].package, "0805");
-  EXPECT_EQ(cell.feeders[1].packages, (std::vector<std::string>{"SOT-23", "SOIC"}));
+  EXPECT_EQ(cell.feeders[1].packages, (std::vector<std::string>{"SOT-23", "SOD-123", "SOIC-8*"}));
+  EXPECT_EQ(cell.feeders[1].kind, FeederKind::kTape);
+  EXPECT_EQ(board.place_z_mm, -3.0);
   EXPECT_EQ(cell.feeders[1].package, "SOT-23");
 }
 
