@@ -29,6 +29,7 @@
 #include "calibration/limits.h"
 #include "calibration/placement_budget.h"
 #include "calibration/tolerances.h"
+#include "frontend/input_kind.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
 
@@ -1141,6 +1142,10 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
   try {
     root = toml::parse(std::string_view(source.text), std::string_view(source.name));
   } catch (const toml::parse_error& error) {
+    // Not TOML: another of smtcal's files given as the cell says so in one message.
+    if (ReportOtherInputKind(file.value(), {InputKind::kCell, InputKind::kToml}, "a cell file", diags)) {
+      return std::optional<Cell>();
+    }
     diags.Report(DiagKind::CellTomlSyntax, SourceRange(loader.At(error.source().begin)),
                  ParseErrorText(error.description()));
     return std::optional<Cell>();

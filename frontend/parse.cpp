@@ -43,6 +43,8 @@
 
 #include <fmt/format.h>
 
+#include "base/field_text.h"
+#include "frontend/input_kind.h"
 #include "frontend/place_lexer.h"
 
 // ANTLR's headers #undef the EOF macro of <cstdio>; they come after every
@@ -488,6 +490,21 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
     return std::nullopt;
   };
   auto cut_after = [&](std::uint32_t index) { line.end = index + 1; };
+
+  // A name followed by '(' is a misspelt function (Palet(1, 2, 1)): the
+  // language's only calls with parentheses are its built-in functions and
+  // the offsets X( ) .. U( ) (and the empty () of Function F() / Call F()).
+  for (std::uint32_t i = line.first; i + 1 < line.end; ++i) {
+    if (TypeOf(tokens_[i]) != P::ID || TypeOf(tokens_[i + 1]) != P::LPAREN) continue;
+    if (i > line.first && (TypeOf(tokens_[i - 1]) == P::FUNCTION || TypeOf(tokens_[i - 1]) == P::CALL)) continue;
+    const std::string name = AsciiLowercase(Text(tokens_[i]));
+    if (name == "x" || name == "y" || name == "z" || name == "u") continue;
+    static const std::vector<std::string> kFunctions = {"Pallet", "XY", "Sw"};
+    const std::string suggestion = ClosestName(Text(tokens_[i]), kFunctions);
+    LineError(line, DiagKind::UnknownFunction, Range(tokens_[i]), std::string(Text(tokens_[i])),
+              suggestion.empty() ? std::string() : fmt::format("; did you mean '{}'?", suggestion));
+    return Drop(line);
+  }
 
   switch (type) {
     case P::FUNCTION: {
@@ -1714,6 +1731,11 @@ ir::Program ParseProgram(std::uint32_t file, Diagnostics& diags) {
                  fmt::format("the file has {} bytes; smtcal reads .place files of less than 4 GiB, so split the "
                              "program into several files",
                              text.size()));
+    ir::Program program;
+    program.file = file;
+    return program;
+  }
+  if (ReportOtherInputKind(file, {InputKind::kProgram}, "a .place program", diags)) {
     ir::Program program;
     program.file = file;
     return program;

@@ -15,6 +15,7 @@
 #include "base/field_text.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_text.h"
+#include "frontend/input_kind.h"
 
 namespace smtcal {
 namespace {
@@ -256,6 +257,12 @@ struct Body {
 };
 
 std::optional<Body> ReadBody(std::uint32_t file, const Schema& schema, Diagnostics& diags) {
+  // Another of smtcal's files (a raw measurement file for `table stats`, a
+  // cell file, a program) is named with the command it belongs to.
+  const InputKind wanted = &schema == &kRawSchema     ? InputKind::kRawMeasurements
+                           : &schema == &kTableSchema ? InputKind::kErrorTable
+                                                      : InputKind::kUnknown;
+  if (ReportOtherInputKind(file, {wanted}, schema.what, diags)) return std::nullopt;
   const std::size_t errors_before = diags.error_count();
   std::vector<CsvRecord> records = SplitCsv(file, diags);
   const std::string& name = diags.sources().File(file).name;

@@ -132,7 +132,16 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
                    : directory             ? directory->Commit(*linuxcnc)
                                            : WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc, review.text()));
   if (written && report) written = report->Commit();
-  if (!written) options.exit_code = ReportIoError(written.error());
+  if (!written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  const std::string what = opt.target == "c"       ? "the C runtime's data"
+                           : opt.target == "place" ? "the corrected program"
+                                                   : "the LinuxCNC program and its subroutines";
+  SayDone(options, opt.output,
+          fmt::format("wrote {} ({} for cell '{}', {} targets){}", opt.output, what, compiled.cell->name,
+                      state.targets.size(), opt.report.empty() ? std::string() : " and the report " + opt.report));
 }
 
 void RunVerify(const CompileOptions& opt, GlobalOptions& options) {

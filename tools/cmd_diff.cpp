@@ -92,6 +92,7 @@ void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
     options.exit_code = ReportIoError(written.error());
     return;
   }
+  if (!opt.svg_path.empty()) SayDone(options, opt.svg_path, fmt::format("wrote the picture {}", opt.svg_path));
   options.exit_code = result.summary.gate_passes() || opt.exit_zero ? kExitOk : kExitInputError;
 }
 

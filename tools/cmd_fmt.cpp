@@ -50,12 +50,20 @@ int RunFmt(const FmtOptions& fmt_options, const GlobalOptions& options) {
   }
   if (fmt_options.in_place) {
     // An unchanged file is left alone (its modification time too).
-    if (already_canonical) return kExitOk;
+    if (already_canonical) {
+      SayDone(options, fmt_options.path, fmt::format("{} is already in canonical form; left as it was", fmt_options.path));
+      return kExitOk;
+    }
     Status written = WriteFileAtomically(fmt_options.path, canonical);
-    return written ? kExitOk : ReportIoError(written.error());
+    if (!written) return ReportIoError(written.error());
+    SayDone(options, fmt_options.path, fmt::format("rewrote {} in canonical form", fmt_options.path));
+    return kExitOk;
   }
-  Status written = WriteFileAtomically(fmt_options.output.empty() ? "-" : fmt_options.output, canonical);
-  return written ? kExitOk : ReportIoError(written.error());
+  const std::string output = fmt_options.output.empty() ? "-" : fmt_options.output;
+  Status written = WriteFileAtomically(output, canonical);
+  if (!written) return ReportIoError(written.error());
+  SayDone(options, output, fmt::format("wrote {}", output));
+  return kExitOk;
 }
 
 }  // namespace

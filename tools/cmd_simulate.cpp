@@ -130,7 +130,11 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
     }
   }
   std::string text = opt.json ? JsonText(SimulateReportJson(result, context)) : SimulateReportText(result, context);
-  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
+  if (Status written = WriteFileAtomically("-", text); !written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  if (!opt.svg.empty()) SayDone(options, opt.svg, fmt::format("wrote the picture {}", opt.svg));
 }
 
 }  // namespace

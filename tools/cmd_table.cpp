@@ -52,7 +52,11 @@ void Finish(const Diagnostics& diags, GlobalOptions& options, const std::string&
   options.exit_code = PrintDiagnostics(diags, options);
   if (options.exit_code != kExitOk) return;
   Status written = WriteFileAtomically(output, text);
-  if (!written) options.exit_code = ReportIoError(written.error());
+  if (!written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  SayDone(options, output, fmt::format("wrote {}", output));
 }
 
 OutsidePolicy ParsePolicy(const std::string& name) {

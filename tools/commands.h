@@ -23,8 +23,15 @@ enum ExitCode : int {
 
 struct GlobalOptions {
   std::string diagnostics_format = "text";  // text | json
+  bool quiet = false;                       // -q: no success line
   int exit_code = kExitOk;
 };
+
+// The one line a command prints on stderr when it succeeded and wrote a file
+// (or checked one): "smtcal: wrote layers.corrected.place (...)". Nothing
+// with -q, or when `output` is standard output ("-": the output speaks for
+// itself).
+void SayDone(const GlobalOptions& options, const std::string& output, std::string_view what);
 
 // Prints the diagnostics to stderr in the chosen format. Returns
 // kExitInputError if any is an error, else kExitOk.

@@ -21,6 +21,11 @@ int PrintDiagnostics(const Diagnostics& diags, const GlobalOptions& options) {
   return diags.has_errors() ? kExitInputError : kExitOk;
 }
 
+void SayDone(const GlobalOptions& options, const std::string& output, std::string_view what) {
+  if (options.quiet || output == "-") return;
+  fmt::print(stderr, "smtcal: {}\n", what);
+}
+
 int ReportIoError(const Error& error) {
   fmt::print(stderr, "smtcal: error: {}\n", error.message);
   return kExitIoError;
@@ -84,6 +89,9 @@ int main(int argc, char** argv) {
                  "How to print diagnostics: text (file:line:col, source line, caret) or json")
       ->check(CLI::IsMember({"text", "json"}))
       ->capture_default_str();
+  app.add_flag("-q,--quiet", options.quiet,
+               "No success line on stderr (what a command wrote or checked); diagnostics and errors are still "
+               "printed");
   AddCheckCommand(app, options);
   AddFmtCommand(app, options);
   AddTableCommand(app, options);

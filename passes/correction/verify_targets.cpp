@@ -152,8 +152,9 @@ class VerifyTargets final : public Pass {
                            fixture != nullptr ? fixture->name : "");
       case ErrorSource::kSensor:
         if (fixture != nullptr && fixture->estimator == cell::Estimator::kPaper) {
-          return fmt::format("fixture '{}' uses estimator = \"paper\" (Eq. 4), which extrapolates each edge from "
-                             "two trips; estimator = \"rigid\" fits all trips at once (docs/periphery.md)",
+          return fmt::format("fixture '{}' uses estimator = \"paper\" (Eq. 4, the default when the fixture names "
+                             "none), which extrapolates each edge from two trips; set estimator = \"rigid\" in its "
+                             "[[fixture]] to fit all trips at once (docs/periphery.md)",
                              fixture->name);
         }
         return "a more accurate marker sensor, markers farther apart or more trips would shrink it";
