@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Runs every smtcal command line of README.md and docs/*.md, so the docs
-cannot drift from the program (CTest docs_commands; tests/docs/README.md says
-how to write docs for it).
+"""Runs every smtcal command line of README.md, docs/*.md and
+examples/*/README.md, so the docs cannot drift from the program (CTest
+docs_commands; tests/docs/README.md says how to write docs for it).
 
     run_doc_commands.py --smtcal BUILD/smtcal --source REPO [-v] [--keep] [DOC.md ...]
 
@@ -435,12 +435,15 @@ def main():
     ap.add_argument("--source", required=True, help="the repository (README.md, docs/, examples/)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary copies")
     ap.add_argument("-v", "--verbose", action="store_true", help="print every command run")
-    ap.add_argument("docs", nargs="*", help="documents relative to --source (default README.md docs/*.md)")
+    ap.add_argument("docs", nargs="*",
+                    help="documents relative to --source (default README.md docs/*.md examples/*/README.md)")
     args = ap.parse_args()
     args.smtcal = os.path.abspath(args.smtcal)
     args.source = os.path.abspath(args.source)
-    docs = args.docs or ["README.md"] + sorted("docs/" + f for f in os.listdir(os.path.join(args.source, "docs"))
-                                               if f.endswith(".md"))
+    docs = args.docs or (["README.md"]
+                         + sorted("docs/" + f for f in os.listdir(os.path.join(args.source, "docs")) if f.endswith(".md"))
+                         + sorted(f"examples/{d}/README.md" for d in os.listdir(os.path.join(args.source, "examples"))
+                                  if os.path.isfile(os.path.join(args.source, "examples", d, "README.md"))))
     helps = Help(args.smtcal)
     if helps.get([]) is None:
         print(f"error: {args.smtcal} --help fails")
