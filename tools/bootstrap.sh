@@ -36,7 +36,7 @@ build/smtcal simulate "$example/layers.place" --cell "$example/paper.cell.toml" 
 cat <<NEXT
 bootstrap: done; smtcal is build/smtcal (build/smtcal --help, and --help on every command).
 Next:
-  build/smtcal import YOUR-LIST.pos --cell $example/paper.cell.toml -o board.place
+  build/smtcal import YOUR-LIST.pos --cell $example/paper.cell.toml --feeders $example/feeders.toml -o board.place
       a KiCad, Altium or EasyEDA placement list to a program (docs/import.md)
   build/smtcal verify board.place --cell $example/paper.cell.toml
       every part's error budget against its tolerance (docs/compile.md)
