@@ -14,6 +14,7 @@
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_text.h"
+#include "frontend/input_kind.h"
 #include "frontend/toml_source.h"
 
 namespace smtcal::cad {
@@ -280,6 +281,9 @@ Result<std::optional<FeedersFile>> LoadFeeders(const std::string& path, SourceMa
   try {
     root = toml::parse(std::string_view(source.text), std::string_view(source.name));
   } catch (const toml::parse_error& error) {
+    if (ReportOtherInputKind(file.value(), {InputKind::kFeeders, InputKind::kToml}, "a feeders file", diags)) {
+      return std::optional<FeedersFile>();
+    }
     diags.Report(DiagKind::FeedersSyntax, SourceRange(reader.At(error.source().begin)),
                  std::string(error.description()));
     return std::optional<FeedersFile>();

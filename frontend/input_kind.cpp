@@ -82,10 +82,15 @@ bool Has(const std::vector<std::string>& fields, std::initializer_list<std::stri
   });
 }
 
+// "Fixture Board" but not the TOML key "fixture = ...".
 bool StartsWithWord(std::string_view line, std::string_view word) {
   if (line.size() < word.size()) return false;
   if (AsciiLowercase(line.substr(0, word.size())) != AsciiLowercase(word)) return false;
-  return line.size() == word.size() || line[word.size()] == ' ' || line[word.size()] == '\t';
+  if (line.size() == word.size()) return false;
+  if (line[word.size()] != ' ' && line[word.size()] != '\t') return false;
+  std::string_view rest = Trim(line.substr(word.size()));
+  // A name follows: "Point P = ...", "Function Main", "Pallet 1, ...".
+  return !rest.empty() && (std::isalnum(static_cast<unsigned char>(rest.front())) || rest.front() == '_');
 }
 
 InputKind TomlKind(const std::set<std::string>& tables) {
@@ -108,18 +113,23 @@ InputKind GuessInputKind(std::string_view name, std::string_view text) {
     if (std::string table = TomlTableName(line); !table.empty()) tables.insert(table);
   }
   for (std::string_view line : lines) {
-    if (line.empty()) continue;
+    if (line.starts_with("Altium Designer Pick and Place") || line.starts_with("### Module positions") ||
+        line.starts_with("### Footprint positions")) {
+      return InputKind::kCadList;
+    }
+  }
+  for (std::string_view line : lines) {
     // A program says so at the start of a line; it is never another kind.
-    for (std::string_view word : {"Function", "Program", "Fend", "Point", "Units", "Fixture", "Pallet"}) {
+    for (std::string_view word : {"Function", "Program", "Point", "Fixture", "Pallet", "Taught", "Vacuum"}) {
       if (StartsWithWord(line, word)) return InputKind::kProgram;
+    }
+    if (AsciiLowercase(line) == "fend") return InputKind::kProgram;
+    for (std::string_view units : {"Units mm", "Units in", "Units inch"}) {
+      if (AsciiLowercase(line) == AsciiLowercase(units)) return InputKind::kProgram;
     }
   }
   for (std::string_view line : lines) {
     if (line.empty()) continue;
-    if (line.starts_with("### Module positions") || line.starts_with("### Footprint positions") ||
-        line.starts_with("Altium Designer Pick and Place")) {
-      return InputKind::kCadList;
-    }
     if (line.starts_with("<?xml") || line.starts_with("<svg")) return InputKind::kSvg;
     if (line.starts_with("{")) return InputKind::kJson;
     if (line.starts_with("#") || line.starts_with("'")) continue;  // comments of TOML, CSV, .place
@@ -129,7 +139,12 @@ InputKind GuessInputKind(std::string_view name, std::string_view text) {
     if (!TomlTableName(line).empty()) return TomlKind(tables);
     std::vector<std::string> fields = HeaderFields(line);
     if (Has(fields, {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"})) return InputKind::kRawMeasurements;
-    if (Has(fields, {"axis", "x_mm", "y_mm", "error_mm"})) return InputKind::kErrorTable;
+    // An error table's header holds its columns and no other (a raw file
+    // with a misspelt column gets the reader's message about that column).
+    const bool only_table_columns = std::all_of(fields.begin(), fields.end(), [](const std::string& f) {
+      return f == "axis" || f == "x_mm" || f == "y_mm" || f == "error_mm" || f == "stddev_mm" || f == "n";
+    });
+    if (only_table_columns && Has(fields, {"axis", "x_mm", "y_mm", "error_mm"})) return InputKind::kErrorTable;
     if (Has(fields, {"name", "x_mm", "y_mm"}) && fields.size() <= 4) return InputKind::kTrips;
     for (std::string_view designator : {"designator", "ref", "refdes", "reference"}) {
       if (Has(fields, {designator}) && fields.size() >= 4) return InputKind::kCadList;

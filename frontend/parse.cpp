@@ -497,12 +497,14 @@ void Session::CheckStructure(Line& line, std::vector<OpenBlock>& stack, bool& mi
   for (std::uint32_t i = line.first; i + 1 < line.end; ++i) {
     if (TypeOf(tokens_[i]) != P::ID || TypeOf(tokens_[i + 1]) != P::LPAREN) continue;
     if (i > line.first && (TypeOf(tokens_[i - 1]) == P::FUNCTION || TypeOf(tokens_[i - 1]) == P::CALL)) continue;
+    // After + or -: an offset, whose axis has a message of its own.
+    if (i > line.first && (TypeOf(tokens_[i - 1]) == P::PLUS || TypeOf(tokens_[i - 1]) == P::MINUS)) continue;
     const std::string name = AsciiLowercase(Text(tokens_[i]));
     if (name == "x" || name == "y" || name == "z" || name == "u") continue;
     static const std::vector<std::string> kFunctions = {"Pallet", "XY", "Sw"};
     const std::string suggestion = ClosestName(Text(tokens_[i]), kFunctions);
     LineError(line, DiagKind::UnknownFunction, Range(tokens_[i]), std::string(Text(tokens_[i])),
-              suggestion.empty() ? std::string() : fmt::format("; did you mean '{}'?", suggestion));
+              suggestion.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", suggestion));
     return Drop(line);
   }
 

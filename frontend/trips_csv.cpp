@@ -13,6 +13,7 @@
 
 #include "base/field_text.h"
 #include "calibration/tolerances.h"
+#include "frontend/input_kind.h"
 #include "frontend/table_csv.h"
 
 namespace smtcal {
@@ -132,6 +133,7 @@ std::optional<double> Number(const CsvField& field, std::string_view column, Dia
 
 std::optional<std::vector<TripRow>> ReadTrips(std::uint32_t file, std::size_t expected_trips,
                                               std::string_view fixture, Diagnostics& diags) {
+  if (ReportOtherInputKind(file, {InputKind::kTrips}, "a trip file", diags)) return std::nullopt;
   const std::size_t errors_before = diags.error_count();
   std::vector<CsvRecord> records = SplitCsv(file, diags);
   const std::string& name = diags.sources().File(file).name;

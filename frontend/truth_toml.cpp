@@ -12,6 +12,7 @@
 #include "base/field_text.h"
 #include "calibration/error_table_check.h"
 #include "frontend/table_csv.h"
+#include "frontend/input_kind.h"
 #include "frontend/toml_source.h"
 
 namespace smtcal {
@@ -259,6 +260,9 @@ Result<std::optional<TruthSpec>> LoadTruth(const std::string& path, const cell::
   try {
     root = toml::parse(std::string_view(source.text), std::string_view(source.name));
   } catch (const toml::parse_error& error) {
+    if (ReportOtherInputKind(file.value(), {InputKind::kTruth, InputKind::kToml}, "a truth file", diags)) {
+      return std::optional<TruthSpec>();
+    }
     diags.Report(DiagKind::TruthSyntax, SourceRange(reader.At(error.source().begin)), std::string(error.description()));
     return std::optional<TruthSpec>();
   }

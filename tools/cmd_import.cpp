@@ -20,6 +20,7 @@
 #include "frontend/cad/cad_to_program.h"
 #include "frontend/cell_toml.h"
 #include "frontend/feeders_toml.h"
+#include "frontend/input_kind.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {
@@ -278,6 +279,10 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   if (!list) {
     PrintDiagnostics(diags, options);
     options.exit_code = ReportIoError(list.error());
+    return;
+  }
+  if (ReportOtherInputKind(list.value(), {InputKind::kCadList}, "a CAD placement list", diags)) {
+    options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
   cad::TextEncoding encoding = cad::TextEncoding::kUtf8;

@@ -45,6 +45,25 @@ TEST(InputKind, EveryGoldenProgramIsAProgramOrUnknown) {
   EXPECT_GT(programs, 100);
 }
 
+TEST(InputKind, EveryGoldenCadListIsACadListOrUnknown) {
+  // import reads what the guess does not call something else: a real list
+  // with its own header words must not be refused.
+  int lists = 0;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(fs::path(SMTCAL_SOURCE_DIR) / "tests" / "golden")) {
+    const std::string suite = entry.path().parent_path().filename().string();
+    if (!entry.is_regular_file() || !suite.starts_with("import-")) continue;
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".csv" && ext != ".pos" && ext != ".txt" && ext != ".tsv") continue;
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with("fail_input_is_")) continue;
+    const InputKind kind = KindOfFile(entry.path());
+    EXPECT_TRUE(kind == InputKind::kCadList || kind == InputKind::kUnknown)
+        << entry.path() << " guessed as " << InputKindName(kind);
+    ++lists;
+  }
+  EXPECT_GT(lists, 20);
+}
+
 TEST(InputKind, CadListsAndTrips) {
   EXPECT_EQ(GuessInputKind("board-top.pos", "### Module positions - created on x ###\n### Printed by Pcbnew\n"),
             InputKind::kCadList);

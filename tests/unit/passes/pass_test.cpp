@@ -154,8 +154,11 @@ TEST(CheckCommand, AnUnknownPassIsAUsageErrorListingTheValidOnes) {
 TEST(CheckCommand, ExitCodesAndVerifyEach) {
   CheckRun clean = RunCheck("--verify-each", kCleanProgram);
   EXPECT_EQ(clean.exit_code, 0) << clean.err;
-  EXPECT_EQ(clean.err, "");
+  EXPECT_EQ(clean.err, "smtcal: p.place: no errors, no warnings\n");  // the success line
   EXPECT_EQ(clean.out, "");
+  CheckRun quiet = RunCheck("-q --verify-each", kCleanProgram);
+  EXPECT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");  // -q: no success line
 
   CheckRun warning = RunCheck("", "Program P\nUnits mm\nFunction Main\nFend\nFunction Spare\nFend\n");
   EXPECT_EQ(warning.exit_code, 0);
