@@ -1,6 +1,7 @@
 // The review text, JSON and SVG board plot of a ProgramDiff (diff_report.h).
 // Numbers are rounded where they are printed (0.1 µm and 0.0001° in the
-// text, 0.0001 µm in JSON), never in the diff itself.
+// text; in JSON 0.0001 µm, 0.0001° for directions, 1e-7° for du), never in
+// the diff itself.
 #include "backend/diff/diff_report.h"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/reports/svg_text.h"
+#include "base/field_text.h"
 #include "base/json_text.h"
 
 namespace smtcal::diff {
@@ -135,7 +137,9 @@ namespace {
 
 using nlohmann::ordered_json;
 
-double JsonNumber(double value, double resolution = 1e-4) { return NoNegativeZero(value, resolution); }
+// A number written with `decimals` decimals and nothing after them (not
+// 179.98430000000002), no "-0".
+double JsonNumber(double value, int decimals = 4) { return RoundedToDecimals(value, decimals); }
 
 ordered_json JsonSide(const Side& side) {
   if (!side.loc.known()) return ordered_json();
@@ -170,7 +174,7 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
       m["dx_um"] = JsonNumber(d.dx_um);
       m["dy_um"] = JsonNumber(d.dy_um);
       m["dz_um"] = JsonNumber(d.dz_um);
-      m["du_deg"] = JsonNumber(d.du_deg, 1e-7);
+      m["du_deg"] = JsonNumber(d.du_deg, 7);
       m["d_um"] = JsonNumber(d.d_um);
       m["direction_deg"] = JsonNumber(d.direction_deg);
       moves.push_back(m);

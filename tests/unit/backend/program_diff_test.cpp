@@ -8,12 +8,14 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "backend/diff/diff_report.h"
 #include "backend/diff/program_diff.h"
@@ -336,6 +338,47 @@ TEST(DiffPrograms, OutputIsDeterministic) {
   EXPECT_EQ(svg, PlotDiffSvg(second->diff));
   EXPECT_EQ(svg.rfind("<svg ", 0), 0u);
   EXPECT_NE(svg.find("times enlarged"), std::string::npos);
+}
+
+// ------------------------------------------------------------------ JSON
+
+// The decimals a JSON number is written with ("2.9e-05" has 6).
+int Decimals(const nlohmann::json& number) {
+  const std::string text = number.dump();
+  const std::size_t e = text.find_first_of("eE");
+  const std::string mantissa = text.substr(0, e);
+  const std::size_t dot = mantissa.find('.');
+  int decimals = dot == std::string::npos ? 0 : static_cast<int>(mantissa.size() - dot - 1);
+  if (e != std::string::npos) decimals -= std::stoi(text.substr(e + 1));
+  return std::max(decimals, 0);
+}
+
+// Calls `check(key, number)` for every floating-point number in `json`.
+void ForEachNumber(const nlohmann::json& json, const std::string& key,
+                   const std::function<void(const std::string&, const nlohmann::json&)>& check) {
+  if (json.is_object()) {
+    for (const auto& [k, v] : json.items()) ForEachNumber(v, k, check);
+  } else if (json.is_array()) {
+    for (const nlohmann::json& v : json) ForEachNumber(v, key, check);
+  } else if (json.is_number_float()) {
+    check(key, json);
+  }
+}
+
+TEST(DiffJson, NumbersCarryTheirDecimalsOnly) {
+  // R1 moves 1 mm back along x and 0.274 µm up: toward 179.9843° (as
+  // 1799843 * 1e-4 the double is 179.98430000000002).
+  auto run = RunDiff(kProgram, Replace(kProgram, "XY(5.0, 7.0, -3.0, 0.0) In Layer",
+                                       "XY(4.0, 7.000274, -3.0, 0.05) In Layer"));
+  const nlohmann::json json = nlohmann::json::parse(FormatDiffJson(run->diff));
+  int numbers = 0;
+  ForEachNumber(json, "", [&](const std::string& key, const nlohmann::json& number) {
+    ++numbers;
+    EXPECT_LE(Decimals(number), key == "du_deg" ? 7 : 4) << key << " " << number.dump();
+  });
+  EXPECT_GT(numbers, 10);
+  EXPECT_NE(FormatDiffJson(run->diff).find("\"direction_deg\": 179.9843\n"), std::string::npos)
+      << FormatDiffJson(run->diff);
 }
 
 // ------------------------------------------------------------------ the command
