@@ -85,8 +85,10 @@ std::string BoardText(const BoardPoseModel& board) {
                      scale, board.shift_scale_mm, board.shift_max_mm, board.rotation_sd_deg, board.rotation_max_deg);
 }
 
+// One colour per mode, in SimMode order, whichever modes a run has.
 constexpr std::array<const char*, 6> kModeColours = {"#7f7f7f", "#bcbd22", "#1f77b4",
                                                      "#9467bd", "#ff7f0e", "#2ca02c"};
+const char* ModeColour(SimMode mode) { return kModeColours[static_cast<std::size_t>(mode) % kModeColours.size()]; }
 
 nlohmann::json ProcessJson(const ModeResult& m, const SimResult& result) {
   if (m.placements == 0) return nullptr;
@@ -300,7 +302,15 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     std::string text = "true world: " + DescribeTruth(*context.truth, *context.cell);
     for (std::size_t at = 0; at != std::string::npos;) {
       const std::size_t next = text.find("; ", at);
-      lines.push_back(text.substr(at, next == std::string::npos ? next : next - at));
+      std::string line = text.substr(at, next == std::string::npos ? next : next - at);
+      // A line wider than the picture breaks after a comma.
+      constexpr std::size_t kMaxChars = 150;
+      while (line.size() > kMaxChars && line.rfind(", ", kMaxChars) != std::string::npos) {
+        const std::size_t comma = line.rfind(", ", kMaxChars);
+        lines.push_back(line.substr(0, comma + 1));
+        line = line.substr(comma + 2);
+      }
+      lines.push_back(line);
       at = next == std::string::npos ? next : next + 2;
     }
     return lines;
@@ -328,7 +338,7 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     const Summary s = Summarize(m.errors_um);
     svg += fmt::format("<!-- panel: {} -->\n", SimModeName(m.mode));
     svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", x0, y0 - 24,
-                       kModeColours[i], SimModeName(m.mode));
+                       ModeColour(m.mode), SimModeName(m.mode));
     if (m.placements == 0) {
       // Nothing to scatter: no axes, the reason in the panel.
       svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">nothing placed, {} of {} cycles stopped</text>\n", x0,
@@ -367,7 +377,7 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     svg += fmt::format("<text x=\"{0:.1f}\" y=\"{1:.1f}\" text-anchor=\"middle\" fill=\"#444\" "
                        "transform=\"rotate(-90 {0:.1f} {1:.1f})\">y error (µm)</text>\n",
                        x0 - 40, cy);
-    svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.35\">\n", kModeColours[i]);
+    svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.35\">\n", ModeColour(m.mode));
     std::string outside;
     for (const Eigen::Vector2d& e : m.scatter_um) {
       const double scale = std::max({std::abs(e.x()), std::abs(e.y()), range_um}) / range_um;
@@ -430,6 +440,10 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
   }
   svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#444\">error length "
                      "(µm)</text>\n", hx0 + hw / 2, hist_top + hist_height + 34);
+  if (std::all_of(result.modes.begin(), result.modes.end(), [](const ModeResult& m) { return m.placements == 0; })) {
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-weight=\"bold\">no mode "
+                       "placed a part: nothing to count</text>\n", hx0 + hw / 2, hist_top + hist_height / 2);
+  }
   for (std::size_t i = 0; i < shares.size(); ++i) {
     const ModeResult& m = result.modes[i];
     const double ly = hist_top + 14 + 20 * static_cast<double>(i);
@@ -444,10 +458,10 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
       points += fmt::format("{:.1f},{:.1f} {:.1f},{:.1f} ", hx0 + hw * b / kBins, y, hx0 + hw * (b + 1) / kBins, y);
     }
     svg += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n", points,
-                       kModeColours[i]);
+                       ModeColour(m.mode));
     svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" "
                        "stroke-width=\"3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
-                       hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, kModeColours[i], hx0 + hw + 42, ly,
+                       hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, ModeColour(m.mode), hx0 + hw + 42, ly,
                        SimModeName(m.mode));
   }
   for (std::size_t i = 0; i < truth_lines.size(); ++i) {

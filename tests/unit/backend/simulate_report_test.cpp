@@ -117,5 +117,13 @@ TEST(SimulateSvg, PartlyStoppedModeWithNothingPlacedSaysHowMany) {
   EXPECT_NE(PanelOf(svg, "periphery").find(">no placements: 3 of 4 cycles stopped by</text>"), std::string::npos);
 }
 
+TEST(SimulateSvg, HistogramOfNoPlacementSaysSo) {
+  SimRun run = TwoModes();
+  run.result.modes.erase(run.result.modes.begin());
+  const std::string svg = run.Svg();
+  EXPECT_EQ(Count(svg, "<polyline"), 0u);
+  EXPECT_NE(svg.find(">no mode placed a part: nothing to count</text>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace smtcal
