@@ -13,7 +13,10 @@ namespace smtcal {
 
 // Two-space indented JSON with a final newline. Text that is not UTF-8 (a
 // file name is any bytes on Linux) is written with U+FFFD in place of each
-// invalid byte, as the diagnostics printer does, instead of throwing.
+// invalid byte, as the diagnostics printer does, instead of throwing. Every
+// floating-point number is written with the shortest digits that read back
+// as it (nlohmann alone sometimes writes 0.059409 as 0.059408999999999997),
+// so a number rounded with RoundedToDecimals shows exactly its decimals.
 std::string JsonText(const nlohmann::ordered_json& json);
 std::string JsonText(const nlohmann::json& json);
 

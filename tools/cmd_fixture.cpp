@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "base/field_text.h"
 #include "base/json_text.h"
 #include "calibration/fixture_estimation.h"
 #include "frontend/cell_toml.h"
@@ -154,18 +155,34 @@ std::string Text(const cell::Cell& cell, const cell::Fixture& fixture, const std
   return out;
 }
 
-ordered_json FixJson(const FixEstimate& estimate) {
+// Decimals of the JSON output (docs/periphery.md), as the text prints them:
+// computed lengths and angles to 1e-6 mm and degrees, the scale to 1e-9.
+// The 4 x 4 matrices keep every bit: --previous reads "fix" back, and a
+// reader recomputing a placement from it must get the same numbers. The
+// trips and limits are the user's numbers, as given; a check's value is
+// rounded to 1e-6 of its unit.
+constexpr int kMmDecimals = 6;
+constexpr int kDegDecimals = 6;
+constexpr int kScaleDecimals = 9;
+
+double Mm(double mm) { return RoundedToDecimals(mm, kMmDecimals); }
+
+ordered_json Matrix(const Eigen::Affine3d& transform) {
   ordered_json matrix = ordered_json::array();
   for (int r = 0; r < 4; ++r) {
     ordered_json row = ordered_json::array();
-    for (int c = 0; c < 4; ++c) row.push_back(estimate.fix.matrix()(r, c) + 0.0);
+    for (int c = 0; c < 4; ++c) row.push_back(transform.matrix()(r, c) + 0.0);
     matrix.push_back(row);
   }
-  return {{"matrix", matrix},
-          {"x_mm", estimate.fix.translation().x()},
-          {"y_mm", estimate.fix.translation().y()},
-          {"angle_deg", FixAngleRad(estimate.fix) * kDegPerRad},
-          {"scale", estimate.scale}};
+  return matrix;
+}
+
+ordered_json FixJson(const FixEstimate& estimate) {
+  return {{"matrix", Matrix(estimate.fix)},
+          {"x_mm", Mm(estimate.fix.translation().x())},
+          {"y_mm", Mm(estimate.fix.translation().y())},
+          {"angle_deg", RoundedToDecimals(FixAngleRad(estimate.fix) * kDegPerRad, kDegDecimals)},
+          {"scale", RoundedToDecimals(estimate.scale, kScaleDecimals)}};
 }
 
 std::string Json(const cell::Cell& cell, const cell::Fixture& fixture, const std::string& trips_name,
@@ -186,39 +203,33 @@ std::string Json(const cell::Cell& cell, const cell::Fixture& fixture, const std
     trip["name"] = TripName(k);
     trip["edge"] = EdgeOf(fixture, result.expected[k]);
     trip["path"] = fixture.scan_paths[result.expected[k].path].name;
-    trip["nominal_mm"] = {result.nominal[k].x(), result.nominal[k].y()};
+    trip["nominal_mm"] = {Mm(result.nominal[k].x()), Mm(result.nominal[k].y())};
     trip["missing"] = !result.trips[k].has_value();
     if (result.trips[k]) {
       trip["commanded_mm"] = {result.trips[k]->x(), result.trips[k]->y()};
       trip["z_mm"] = z[k] ? ordered_json(*z[k]) : ordered_json();
-      trip["from_nominal_mm"] = result.window_mm[k];
+      trip["from_nominal_mm"] = Mm(result.window_mm[k]);
       if (result.Check(ScanCheck::kDegenerate).evaluated) {
-        trip["calibrated_mm"] = {result.calibrated[k].x(), result.calibrated[k].y()};
+        trip["calibrated_mm"] = {Mm(result.calibrated[k].x()), Mm(result.calibrated[k].y())};
         trip["region"] = result.region[k] < 0 ? ordered_json() : ordered_json(RegionName(cell, result.region[k]));
       }
-      if (result.estimate) trip["residual_mm"] = result.estimate->residual_mm[k];
+      if (result.estimate) trip["residual_mm"] = Mm(result.estimate->residual_mm[k]);
     }
     trips.push_back(trip);
   }
   out["trips"] = trips;
   if (result.estimate) {
     out["s_mm"] = ordered_json::array();
-    for (const Eigen::Vector2d& s : result.estimate->s) out["s_mm"].push_back({s.x(), s.y()});
+    for (const Eigen::Vector2d& s : result.estimate->s) out["s_mm"].push_back({Mm(s.x()), Mm(s.y())});
   } else {
     out["s_mm"] = nullptr;
   }
   out["fix"] = result.fix ? FixJson(*result.estimate) : ordered_json();
   out["estimate"] = result.estimate ? FixJson(*result.estimate) : ordered_json();
   if (result.delta) {
-    ordered_json matrix = ordered_json::array();
-    for (int r = 0; r < 4; ++r) {
-      ordered_json row = ordered_json::array();
-      for (int c = 0; c < 4; ++c) row.push_back(result.delta->matrix()(r, c) + 0.0);
-      matrix.push_back(row);
-    }
-    out["delta"] = {{"matrix", matrix},
-                    {"shift_mm", result.Check(ScanCheck::kCycleShift).value},
-                    {"rotation_deg", result.Check(ScanCheck::kCycleRotation).value}};
+    out["delta"] = {{"matrix", Matrix(*result.delta)},
+                    {"shift_mm", Mm(result.Check(ScanCheck::kCycleShift).value)},
+                    {"rotation_deg", RoundedToDecimals(result.Check(ScanCheck::kCycleRotation).value, kDegDecimals)}};
   } else {
     out["delta"] = nullptr;
   }
@@ -228,7 +239,7 @@ std::string Json(const cell::Cell& cell, const cell::Fixture& fixture, const std
     entry["name"] = ScanCheckName(check.check);
     entry["evaluated"] = check.evaluated;
     entry["passed"] = check.evaluated ? ordered_json(check.passed) : ordered_json();
-    entry["value"] = check.evaluated ? ordered_json(check.value) : ordered_json();
+    entry["value"] = check.evaluated ? ordered_json(RoundedToDecimals(check.value, kMmDecimals)) : ordered_json();
     entry["limit"] = check.limit;
     entry["unit"] = ScanCheckUnit(check.check);
     entry["trip"] = check.trip >= 0 ? ordered_json(TripName(static_cast<std::size_t>(check.trip))) : ordered_json();

@@ -1,6 +1,7 @@
 // The review text, JSON and SVG board plot of a ProgramDiff (diff_report.h).
 // Numbers are rounded where they are printed (0.1 µm and 0.0001° in the
-// text, 0.0001 µm in JSON), never in the diff itself.
+// text; in JSON 0.0001 µm, 0.0001° for directions, 1e-7° for du), never in
+// the diff itself.
 #include "backend/diff/diff_report.h"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "backend/reports/svg_text.h"
+#include "base/field_text.h"
 #include "base/json_text.h"
 
 namespace smtcal::diff {
@@ -135,7 +137,9 @@ namespace {
 
 using nlohmann::ordered_json;
 
-double JsonNumber(double value, double resolution = 1e-4) { return NoNegativeZero(value, resolution); }
+// A number written with `decimals` decimals and nothing after them (not
+// 179.98430000000002), no "-0".
+double JsonNumber(double value, int decimals = 4) { return RoundedToDecimals(value, decimals); }
 
 ordered_json JsonSide(const Side& side) {
   if (!side.loc.known()) return ordered_json();
@@ -170,7 +174,7 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
       m["dx_um"] = JsonNumber(d.dx_um);
       m["dy_um"] = JsonNumber(d.dy_um);
       m["dz_um"] = JsonNumber(d.dz_um);
-      m["du_deg"] = JsonNumber(d.du_deg, 1e-7);
+      m["du_deg"] = JsonNumber(d.du_deg, 7);
       m["d_um"] = JsonNumber(d.d_um);
       m["direction_deg"] = JsonNumber(d.direction_deg);
       moves.push_back(m);
@@ -207,10 +211,15 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
 
 namespace {
 
-constexpr double kPanelPx = 560;      // the longer side of a panel's plot area
-constexpr double kMarginPx = 60;
-constexpr double kArrowFill = 0.12;   // the largest move drawn as this share of the panel's span
-constexpr std::size_t kLabelled = 5;  // the largest moves get a label
+constexpr double kPanelPx = 560;        // the longer side of a panel's plot area
+constexpr double kMinPanelWidthPx = 340;  // room for the title and the labels of a thin panel
+constexpr double kMinPanelHeightPx = 220;
+constexpr double kMarginPx = 60;        // left of the header
+constexpr double kAxisRoomPx = 70;      // left of a panel: the y ticks and label
+constexpr double kArrowFill = 0.12;     // the largest move drawn as this share of the panel's span
+constexpr std::size_t kLabelled = 5;    // the largest moves get a label
+constexpr double kLabelFontPx = 11;
+constexpr double kLeaderFromPx = 8;     // a label further than this from its arrow's tip gets a leader line
 constexpr double kUmPerMm = 1000;
 
 std::string Num(double v) { return fmt::format("{:.2f}", NoNegativeZero(v, 0.01)); }
@@ -233,11 +242,17 @@ struct Mark {
 struct Panel {
   std::string frame;
   std::vector<Mark> marks;
+  std::size_t compared = 0, added = 0, removed = 0;  // what the marks are
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // mm
   double left = 0, top = 0, scale = 1, width = 0, height = 0;
   double Px(double x) const { return left + (x - x0) * scale; }
   double Py(double y) const { return top + (y1 - y) * scale; }  // y up, as on the robot
 };
+
+// What a panel's numbers are in: "robot base frame", "fixture Board's frame".
+std::string FrameName(const std::string& frame) {
+  return frame == "robot base" ? "robot base frame" : fmt::format("fixture {}'s frame", frame);
+}
 
 void Arrow(std::string& svg, double x0, double y0, double x1, double y1, std::string_view colour) {
   svg += fmt::format("    <line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"{}\" stroke-width=\"1.4\"/>\n",
@@ -256,6 +271,102 @@ std::string ShortName(const Change& c) {
   return fmt::format("line {}", c.new_side.loc.line);
 }
 
+// ---- label placement: boxes in pixels, greedy, nothing drawn over another
+
+struct Box {
+  double x0, y0, x1, y1;
+  bool Overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+  bool Inside(const Box& o) const { return x0 >= o.x0 && y0 >= o.y0 && x1 <= o.x1 && y1 <= o.y1; }
+};
+
+struct Segment {
+  double x0, y0, x1, y1;
+};
+
+// Whether a segment passes through a box (Liang-Barsky clipping).
+bool Crosses(const Segment& s, const Box& b) {
+  double t0 = 0, t1 = 1;
+  const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {s.x0 - b.x0, b.x1 - s.x0, s.y0 - b.y0, b.y1 - s.y0};
+  for (int k = 0; k < 4; ++k) {
+    if (p[k] == 0) {
+      if (q[k] < 0) return false;
+      continue;
+    }
+    const double t = q[k] / p[k];
+    if (p[k] < 0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// The width of a label in pixels, generously (sans-serif digits are 0.55 to 0.64 em, letters less).
+double LabelWidth(std::string_view text) {
+  std::size_t chars = 0;
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t length = Utf8Length(text, i);
+    i += length == 0 ? 1 : length;
+    ++chars;
+  }
+  return 0.56 * kLabelFontPx * static_cast<double>(chars);
+}
+
+// The distance from a point to a box (0 inside).
+double Distance(double x, double y, const Box& b) {
+  return std::hypot(x - std::clamp(x, b.x0, b.x1), y - std::clamp(y, b.y0, b.y1));
+}
+
+// Where a label goes: the first box around its arrow's tip (ax, ay), nearest
+// first in eight directions, inside `area`, that covers no drawn mark, arrow
+// or earlier label. Right beside the tip it must also be nearer its own tip
+// than any other mark's point (`points`), so it cannot be read as another's;
+// further away a leader line says whose it is. Else the box that covers fewest.
+Box PlaceLabel(double ax, double ay, double width, const Box& area, const std::vector<Box>& marks,
+               const std::vector<Segment>& arrows, const std::vector<Box>& labels,
+               const std::vector<std::pair<double, double>>& points) {
+  const double height = kLabelFontPx + 3;
+  Box best{};
+  int best_hits = -1;
+  for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0}) {
+    for (int direction = 0; direction < 8; ++direction) {
+      // E, W, N, S, NE, SE, NW, SW
+      const int hx = direction == 0 || direction == 4 || direction == 5 ? 1
+                     : direction == 1 || direction == 6 || direction == 7 ? -1
+                                                                         : 0;
+      const int vy = direction == 2 || direction == 4 || direction == 6 ? -1
+                     : direction == 3 || direction == 5 || direction == 7 ? 1
+                                                                         : 0;
+      const double diagonal = hx != 0 && vy != 0 ? 0.7 : 1.0;
+      const double left = hx > 0 ? ax + d * diagonal : hx < 0 ? ax - d * diagonal - width : ax - width / 2;
+      const double top = vy > 0 ? ay + d * diagonal : vy < 0 ? ay - d * diagonal - height : ay - height / 2;
+      const Box box{left, top, left + width, top + height};
+      if (!box.Inside(area)) continue;
+      int hits = 0;
+      for (const Box& m : marks) hits += box.Overlaps(m);
+      for (const Segment& a : arrows) hits += Crosses(a, box);
+      for (const Box& l : labels) hits += 2 * box.Overlaps(l);
+      if (d <= kLeaderFromPx) {
+        const double own = Distance(ax, ay, box);
+        for (const auto& [x, y] : points) hits += Distance(x, y, box) < own + 6;
+      }
+      if (hits == 0) return box;
+      if (best_hits < 0 || hits < best_hits) {
+        best = box;
+        best_hits = hits;
+      }
+    }
+  }
+  if (best_hits < 0) {  // the panel is smaller than the label: beside the tip
+    best = {ax + 5, ay - height / 2, ax + 5 + width, ay + height / 2};
+  }
+  return best;
+}
+
 }  // namespace
 
 std::string PlotDiffSvg(const ProgramDiff& diff) {
@@ -265,20 +376,26 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     if (!change.is_target || change.plot_frame.empty()) continue;
     Mark mark;
     mark.change = &change;
+    Panel& panel = by_frame[change.plot_frame];
     if (change.old_plot && change.new_plot) {
       mark.at = *change.old_plot;
       mark.to = *change.new_plot;
+      ++panel.compared;
     } else if (change.old_plot) {
       mark.at = *change.old_plot;
+      ++panel.removed;
     } else if (change.new_plot) {
       mark.at = *change.new_plot;
+      ++panel.added;
     } else {
       continue;
     }
-    by_frame[change.plot_frame].marks.push_back(mark);
+    panel.marks.push_back(mark);
   }
   for (std::size_t i = 0; i < diff.unchanged_plot.size(); ++i) {
-    by_frame[diff.unchanged_plot_frame[i]].marks.push_back({nullptr, diff.unchanged_plot[i], std::nullopt});
+    Panel& panel = by_frame[diff.unchanged_plot_frame[i]];
+    panel.marks.push_back({nullptr, diff.unchanged_plot[i], std::nullopt});
+    ++panel.compared;
   }
   std::vector<Panel> panels;
   if (auto base = by_frame.find("robot base"); base != by_frame.end()) {
@@ -290,6 +407,11 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     panels.push_back(std::move(panel));
     panels.back().frame = frame;
   }
+  // The compared targets (the text report's "targets compared") that have
+  // no single static position to draw.
+  std::size_t drawn = 0;
+  for (const Panel& p : panels) drawn += p.compared;
+  const std::size_t not_drawn = diff.summary.targets_compared - std::min(drawn, diff.summary.targets_compared);
 
   // One enlargement for all panels: the largest move spans kArrowFill of the
   // widest panel.
@@ -308,22 +430,60 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   }
   const double enlarge = largest_mm > 0 ? NiceFloor(kArrowFill * span_mm / largest_mm) : 1;
   const double pad_mm = std::max(0.08 * span_mm, enlarge * largest_mm);
-  double x = kMarginPx, height = 0;
+  // The header: what the marks mean, then what the panels count.
+  std::vector<std::string> header;
+  header.push_back(largest_mm > 0 ? fmt::format("grey: unchanged; blue dot and arrow: moved, old position to new, the "
+                                                 "arrow {} times enlarged (red: more than {} µm)",
+                                                 fmt::format("{:g}", enlarge), Um(diff.threshold_um))
+                                   : std::string("grey: unchanged (no drawn target moved)"));
+  header.push_back(fmt::format("green +: added; red ×: removed. {}",
+                               diff.base_frame_known ? "Fixture targets at the fixtures' nominal poses (--cell)."
+                                                     : "Fixture targets in their fixture's frame (no --cell)."));
+  {
+    std::vector<std::string> where;
+    for (const Panel& p : panels) {
+      if (p.compared > 0) where.push_back(fmt::format("{} in the {}", p.compared, FrameName(p.frame)));
+    }
+    if (not_drawn > 0) where.push_back(fmt::format("{} not drawn", not_drawn));
+    std::string line = fmt::format("{} target{} compared (as in the text report)", diff.summary.targets_compared,
+                                   diff.summary.targets_compared == 1 ? "" : "s");
+    if (!where.empty()) line += ": " + fmt::format("{}", fmt::join(where, ", "));
+    std::size_t added = 0, removed = 0;
+    for (const Panel& p : panels) {
+      added += p.added;
+      removed += p.removed;
+    }
+    if (added + removed > 0) line += fmt::format("; also drawn: {} added, {} removed", added, removed);
+    header.push_back(line);
+  }
+  if (not_drawn > 0) {
+    header.push_back("not drawn: no single static position (offsets or pallet slots known only at run time, or a "
+                     "frame that changed)");
+  }
+  const double panel_top = 50 + 18 * static_cast<double>(header.size()) + 50;
+  double x = kAxisRoomPx, height = 0;
   for (Panel& p : panels) {
     p.x0 -= pad_mm;
     p.x1 += pad_mm;
     p.y0 -= pad_mm;
     p.y1 += pad_mm;
     p.scale = kPanelPx / std::max(p.x1 - p.x0, p.y1 - p.y0);
+    // A thin panel is widened (or heightened) about its centre.
+    const double grow_x = std::max(0.0, kMinPanelWidthPx / p.scale - (p.x1 - p.x0)) / 2;
+    const double grow_y = std::max(0.0, kMinPanelHeightPx / p.scale - (p.y1 - p.y0)) / 2;
+    p.x0 -= grow_x;
+    p.x1 += grow_x;
+    p.y0 -= grow_y;
+    p.y1 += grow_y;
     p.width = (p.x1 - p.x0) * p.scale;
     p.height = (p.y1 - p.y0) * p.scale;
     p.left = x;
-    p.top = 110;
-    x += p.width + kMarginPx;
+    p.top = panel_top;
+    x += p.width + kAxisRoomPx + 20;
     height = std::max(height, p.height);
   }
-  const double width = std::max(x + 80, 900.0);  // room for the labels of the rightmost targets
-  const double total_height = 110 + height + 70;
+  const double width = std::max(x, 900.0);
+  const double total_height = panel_top + height + 80;
 
   // The largest moves get labels.
   std::vector<const Change*> ranked;
@@ -340,30 +500,63 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   svg += "  <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   svg += fmt::format("  <text x=\"{}\" y=\"28\" font-size=\"17\" font-weight=\"bold\">What moves: {} -&gt; {}</text>\n",
                      Num(kMarginPx), SvgEscape(diff.old_file), SvgEscape(diff.new_file));
-  svg += fmt::format(
-      "  <text x=\"{}\" y=\"50\" fill=\"#333\">grey: unchanged; blue dot and arrow: moved, old position to new, "
-      "the arrow {} times enlarged (red: more than {} µm)</text>\n",
-      Num(kMarginPx), fmt::format("{:g}", enlarge), Um(diff.threshold_um));
-  svg += fmt::format(
-      "  <text x=\"{}\" y=\"68\" fill=\"#333\">green +: added; red ×: removed. Coordinates in mm; "
-      "{}</text>\n",
-      Num(kMarginPx),
-      diff.base_frame_known ? "fixture targets at the fixtures' nominal poses (--cell)"
-                            : "fixture targets in their fixture's frame (no --cell)");
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    svg += fmt::format("  <text x=\"{}\" y=\"{}\" fill=\"#333\">{}</text>\n", Num(kMarginPx),
+                       Num(50 + 18 * static_cast<double>(i)), SvgEscape(header[i]));
+  }
   if (panels.empty()) {
-    svg += fmt::format("  <text x=\"{}\" y=\"130\">no target has a static position to draw</text>\n", Num(kMarginPx));
+    svg += fmt::format("  <text x=\"{}\" y=\"{}\">no target has a static position to draw</text>\n", Num(kMarginPx),
+                       Num(panel_top));
   }
   for (const Panel& p : panels) {
     svg += fmt::format("  <!-- panel: {} -->\n", SvgEscape(p.frame));
-    svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{} ({} targets)</text>\n",
-                       Num(p.left), Num(p.top - 12), SvgEscape(p.frame), p.marks.size());
+    std::string counts = fmt::format("{} of the {} compared target{}", p.compared, diff.summary.targets_compared,
+                                     diff.summary.targets_compared == 1 ? "" : "s");
+    if (p.added > 0) counts += fmt::format("; {} added", p.added);
+    if (p.removed > 0) counts += fmt::format("; {} removed", p.removed);
+    svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{}, mm</text>\n",
+                       Num(p.left), Num(p.top - 28), SvgEscape(FrameName(p.frame)));
+    svg += fmt::format("  <text x=\"{}\" y=\"{}\" fill=\"#333\">{}</text>\n", Num(p.left), Num(p.top - 10),
+                       SvgEscape(counts));
     svg += fmt::format("  <rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#999\"/>\n",
                        Num(p.left), Num(p.top), Num(p.width), Num(p.height));
-    svg += fmt::format("  <text x=\"{}\" y=\"{}\" fill=\"#555\">x {}..{} mm, y {}..{} mm</text>\n", Num(p.left),
-                       Num(p.top + p.height + 16), Num(p.x0), Num(p.x1), Num(p.y0), Num(p.y1));
-    svg += "  <g>\n";
+    // Ticks at round millimetres, the same step on both axes (one scale).
+    const double step = SvgTickStep(std::max(p.x1 - p.x0, p.y1 - p.y0), 7);
+    svg += "  <g stroke=\"#eee\">\n";
+    for (double t : SvgTicks(p.x0, p.x1, step)) {
+      svg += fmt::format("    <line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\"/>\n", Num(p.Px(t)), Num(p.top),
+                         Num(p.top + p.height));
+    }
+    for (double t : SvgTicks(p.y0, p.y1, step)) {
+      svg += fmt::format("    <line x1=\"{1}\" y1=\"{0}\" x2=\"{2}\" y2=\"{0}\"/>\n", Num(p.Py(t)), Num(p.left),
+                         Num(p.left + p.width));
+    }
+    svg += "  </g>\n  <g fill=\"#444\">\n";
+    for (double t : SvgTicks(p.x0, p.x1, step)) {
+      svg += fmt::format("    <line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"#666\"/>"
+                         "<text x=\"{0}\" y=\"{3}\" text-anchor=\"middle\">{4}</text>\n",
+                         Num(p.Px(t)), Num(p.top + p.height), Num(p.top + p.height + 4), Num(p.top + p.height + 16),
+                         SvgTickText(t, step));
+    }
+    for (double t : SvgTicks(p.y0, p.y1, step)) {
+      svg += fmt::format("    <line x1=\"{0}\" y1=\"{2}\" x2=\"{1}\" y2=\"{2}\" stroke=\"#666\"/>"
+                         "<text x=\"{3}\" y=\"{4}\" text-anchor=\"end\">{5}</text>\n",
+                         Num(p.left - 4), Num(p.left), Num(p.Py(t)), Num(p.left - 6), Num(p.Py(t) + 4),
+                         SvgTickText(t, step));
+    }
+    svg += fmt::format("    <text x=\"{}\" y=\"{}\" text-anchor=\"middle\">x (mm)</text>\n",
+                       Num(p.left + p.width / 2), Num(p.top + p.height + 32));
+    svg += fmt::format("    <text x=\"{0}\" y=\"{1}\" text-anchor=\"middle\" transform=\"rotate(-90 {0} {1})\">"
+                       "y (mm)</text>\n",
+                       Num(p.left - 48), Num(p.top + p.height / 2));
+    svg += "  </g>\n  <g>\n";
+    std::vector<Box> mark_boxes;
+    std::vector<Segment> arrows;
+    std::vector<std::pair<const Change*, std::pair<double, double>>> points;  // dots and arrow tips, by owner
     for (const Mark& m : p.marks) {
       double px = p.Px(m.at[0]), py = p.Py(m.at[1]);
+      mark_boxes.push_back({px - 5, py - 5, px + 5, py + 5});
+      points.push_back({m.change, {px, py}});
       if (m.change == nullptr) {
         svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"2.2\" fill=\"#aaa\"/>\n", Num(px), Num(py));
       } else if (m.change->kind == ChangeKind::kAdded) {
@@ -378,16 +571,40 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
           double tx = m.at[0] + enlarge * ((*m.to)[0] - m.at[0]);
           double ty = m.at[1] + enlarge * ((*m.to)[1] - m.at[1]);
           Arrow(svg, px, py, p.Px(tx), p.Py(ty), m.change->beyond_threshold ? "#d7191c" : "#2b83ba");
+          arrows.push_back({px, py, p.Px(tx), p.Py(ty)});
+          mark_boxes.push_back({p.Px(tx) - 4, p.Py(ty) - 4, p.Px(tx) + 4, p.Py(ty) + 4});
+          points.push_back({m.change, {p.Px(tx), p.Py(ty)}});
         }
       }
     }
-    for (std::size_t rank = 0; rank < ranked.size(); ++rank) {
-      const Change* c = ranked[rank];
+    // Labels inside the frame, clear of every mark, arrow and other label;
+    // a thin leader line when one had to move away from its arrow.
+    const Box area{p.left + 2, p.top + 2, p.left + p.width - 2, p.top + p.height - 2};
+    std::vector<Box> labels;
+    for (const Change* c : ranked) {
       if (c->plot_frame != p.frame) continue;
-      double tx = (*c->old_plot)[0] + enlarge * ((*c->new_plot)[0] - (*c->old_plot)[0]);
-      double ty = (*c->old_plot)[1] + enlarge * ((*c->new_plot)[1] - (*c->old_plot)[1]);
-      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"11\">{}: {} µm</text>\n", Num(p.Px(tx) + 6),
-                         Num(p.Py(ty) + (rank % 2 == 0 ? -4.0 : 12.0)), SvgEscape(ShortName(*c)), Um(c->gate_um));
+      const double tx = p.Px((*c->old_plot)[0] + enlarge * ((*c->new_plot)[0] - (*c->old_plot)[0]));
+      const double ty = p.Py((*c->old_plot)[1] + enlarge * ((*c->new_plot)[1] - (*c->old_plot)[1]));
+      const std::string text = fmt::format("{}: {} µm", ShortName(*c), Um(c->gate_um));
+      std::vector<std::pair<double, double>> others;
+      for (const auto& [owner, at] : points) {
+        if (owner != c) others.push_back(at);
+      }
+      const Box box = PlaceLabel(tx, ty, LabelWidth(text), area, mark_boxes, arrows, labels, others);
+      labels.push_back(box);
+      const double nx = std::clamp(tx, box.x0, box.x1), ny = std::clamp(ty, box.y0, box.y1);
+      if (std::hypot(nx - tx, ny - ty) > kLeaderFromPx) {
+        svg += fmt::format("    <line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"#777\" stroke-width=\"0.7\"/>\n",
+                           Num(tx), Num(ty), Num(nx), Num(ny));
+        arrows.push_back({tx, ty, nx, ny});
+      }
+      // The text hugs the side of its box that faces the tip (the width is an estimate).
+      const bool left_of_tip = box.x1 <= tx, right_of_tip = box.x0 >= tx;
+      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"{:g}\"{}>{}</text>\n",
+                         Num(left_of_tip ? box.x1 - 1 : right_of_tip ? box.x0 + 1 : (box.x0 + box.x1) / 2),
+                         Num(box.y1 - 3), kLabelFontPx,
+                         left_of_tip ? " text-anchor=\"end\"" : right_of_tip ? "" : " text-anchor=\"middle\"",
+                         SvgEscape(text));
     }
     svg += "  </g>\n";
   }
@@ -396,7 +613,7 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     const Panel& p = panels.front();
     double bar_um = NiceFloor(largest_mm * kUmPerMm);
     double bar_px = bar_um / kUmPerMm * enlarge * p.scale;
-    double y = p.top + p.height + 44;
+    double y = p.top + p.height + 58;
     svg += "  <g>\n";
     Arrow(svg, p.left, y, p.left + bar_px, y, "#2b83ba");
     svg += "  </g>\n";

@@ -16,13 +16,28 @@ namespace {
 
 using nlohmann::json;
 
+// Decimals of the JSON report's numbers (docs/compile.md, "The report").
+// Poses (targets, taught points, fixtures) as the corrected program writes
+// its coordinates (1e-10 mm and degrees, RoundForProgramText), so a
+// report's nominal reads exactly as the program's; residuals to
+// kInversePolishMm; times to a microsecond.
+constexpr int kPoseDecimals = 10;
+constexpr int kResidualDecimals = 12;
+constexpr int kSecondsDecimals = 6;
+constexpr int kShareDecimals = 6;
+
 json PoseJson(const Pose4& pose) {
-  return json{{"x_mm", pose[0]}, {"y_mm", pose[1]}, {"z_mm", pose[2]}, {"u_deg", pose[3]}};
+  return json{{"x_mm", RoundedJson(pose[0], kPoseDecimals)},
+              {"y_mm", RoundedJson(pose[1], kPoseDecimals)},
+              {"z_mm", RoundedJson(pose[2], kPoseDecimals)},
+              {"u_deg", RoundedJson(pose[3], kPoseDecimals)}};
 }
 
 json FixJson(const Eigen::Affine3d& fix) {
   std::array<double, 4> pose = PoseValues(fix);
-  return json{{"x_mm", pose[0]}, {"y_mm", pose[1]}, {"angle_deg", pose[3]}};
+  return json{{"x_mm", RoundedJson(pose[0], kPoseDecimals)},
+              {"y_mm", RoundedJson(pose[1], kPoseDecimals)},
+              {"angle_deg", RoundedJson(pose[3], kPoseDecimals)}};
 }
 
 std::string FixtureName(const CompileState& state, int fixture) {
@@ -75,7 +90,7 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
     entry["required"] = PoseJson(target.required);
     entry["nominal"] = PoseJson(target.nominal);
     entry["region"] = target.region != nullptr ? json(target.region->name) : json(nullptr);
-    entry["residual_mm"] = target.residual_mm;
+    entry["residual_mm"] = RoundedJson(target.residual_mm, kResidualDecimals);
     entry["iterations"] = target.iterations;
     entry["iteration_bound"] = target.iteration_bound;
     if (target.kind != CorrectionKind::kUncorrected) {
@@ -114,10 +129,10 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
     cycles.push_back(json{{"fixture", cycle.fixture},
                           {"location", LocationText(sources, cycle.cycle->loc)},
                           {"placements", cycle.placements},
-                          {"motion_s", cycle.motion_s},
-                          {"scan_s", cycle.scan_s},
-                          {"total_s", total},
-                          {"scan_share", total > 0 ? cycle.scan_s / total : 0.0}});
+                          {"motion_s", RoundedJson(cycle.motion_s, kSecondsDecimals)},
+                          {"scan_s", RoundedJson(cycle.scan_s, kSecondsDecimals)},
+                          {"total_s", RoundedJson(total, kSecondsDecimals)},
+                          {"scan_share", RoundedJson(total > 0 ? cycle.scan_s / total : 0.0, kShareDecimals)}});
   }
   json process = json::object();
   for (const auto& [name, capability] : PredictedCapability(state)) process[name] = CapabilityJson(capability);

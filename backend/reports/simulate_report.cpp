@@ -85,8 +85,10 @@ std::string BoardText(const BoardPoseModel& board) {
                      scale, board.shift_scale_mm, board.shift_max_mm, board.rotation_sd_deg, board.rotation_max_deg);
 }
 
+// One colour per mode, in SimMode order, whichever modes a run has.
 constexpr std::array<const char*, 6> kModeColours = {"#7f7f7f", "#bcbd22", "#1f77b4",
                                                      "#9467bd", "#ff7f0e", "#2ca02c"};
+const char* ModeColour(SimMode mode) { return kModeColours[static_cast<std::size_t>(mode) % kModeColours.size()]; }
 
 nlohmann::json ProcessJson(const ModeResult& m, const SimResult& result) {
   if (m.placements == 0) return nullptr;
@@ -263,25 +265,57 @@ nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext
           {"modes", modes}};
 }
 
+namespace {
+
+// The note drawn in the panel of a mode that placed nothing: why, with the
+// checks that stopped its cycles (the first failed check of each).
+std::vector<std::string> NothingPlacedNote(const ModeResult& m) {
+  std::vector<std::string> lines;
+  if (m.faults == 0) {
+    lines.push_back("no placements: the cycles place no part");
+    return lines;
+  }
+  lines.push_back(m.faults == m.cycles ? "no placements: every cycle stopped by"
+                                       : fmt::format("no placements: {} of {} cycles stopped by", m.faults, m.cycles));
+  for (const auto& [check, count] : m.fault_checks) {
+    lines.push_back(fmt::format("{} ({} cycle{})", check, count, count == 1 ? "" : "s"));
+  }
+  return lines;
+}
+
+}  // namespace
+
 std::string SimulateReportSvg(const SimResult& result, const SimulateContext& context) {
-  constexpr double kPanel = 280, kGap = 50, kLeft = 50, kTop = 115;
+  // Panels kPanel square, kLeft and kGap leave room for the y ticks and label,
+  // kRowGap for the x ticks and label and the next row's titles.
+  constexpr double kPanel = 280, kGap = 90, kRowGap = 90, kLeft = 80, kTop = 115;
   constexpr int kColumns = 3;
   const double tolerance_um = 1000 * (result.tolerance_mm > 0 ? result.tolerance_mm : 0.1);
   const double range_um = 2.5 * tolerance_um;  // scatter: +-range around the required position
+  const double scatter_step_um = SvgTickStep(2 * range_um, 5);
+  const std::vector<double> scatter_ticks = SvgTicks(-range_um, range_um, scatter_step_um);
   const int rows = static_cast<int>((result.modes.size() + kColumns - 1) / kColumns);
   const double width = kLeft + kColumns * (kPanel + kGap);
-  const double hist_top = kTop + rows * (kPanel + kGap) + 30, hist_height = 260;
+  const double hist_top = kTop + rows * (kPanel + kRowGap) + 30, hist_height = 260;
   const std::vector<std::string> truth_lines = [&] {
     std::vector<std::string> lines;
     std::string text = "true world: " + DescribeTruth(*context.truth, *context.cell);
     for (std::size_t at = 0; at != std::string::npos;) {
       const std::size_t next = text.find("; ", at);
-      lines.push_back(text.substr(at, next == std::string::npos ? next : next - at));
+      std::string line = text.substr(at, next == std::string::npos ? next : next - at);
+      // A line wider than the picture breaks after a comma.
+      constexpr std::size_t kMaxChars = 150;
+      while (line.size() > kMaxChars && line.rfind(", ", kMaxChars) != std::string::npos) {
+        const std::size_t comma = line.rfind(", ", kMaxChars);
+        lines.push_back(line.substr(0, comma + 1));
+        line = line.substr(comma + 2);
+      }
+      lines.push_back(line);
       at = next == std::string::npos ? next : next + 2;
     }
     return lines;
   }();
-  const double height = hist_top + hist_height + 50 + 16 * static_cast<double>(truth_lines.size());
+  const double height = hist_top + hist_height + 64 + 16 * static_cast<double>(truth_lines.size());
   std::string svg = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{:.0f}\" height=\"{:.0f}\" viewBox=\"0 0 {:.0f} {:.0f}\" "
       "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
@@ -291,7 +325,7 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
                      kLeft, SvgEscape(std::filesystem::path(context.program).filename().string()),
                      SvgEscape(context.cell->name), result.cycles, result.options.seed);
   svg += fmt::format("<text x=\"{}\" y=\"46\">Each dot: one placed part, where it landed relative to where it "
-                     "belongs, in µm (up to {} per mode, the same parts in every mode).</text>\n",
+                     "belongs, x and y error in µm (up to {} per mode, the same parts in every mode).</text>\n",
                      kLeft, result.options.scatter_points);
   svg += fmt::format("<text x=\"{}\" y=\"64\">Dashed circle: the tolerance ±{:.0f} µm. Red: beyond ±{:.0f} µm, "
                      "drawn at the border.</text>\n",
@@ -299,23 +333,51 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
   for (std::size_t i = 0; i < result.modes.size(); ++i) {
     const ModeResult& m = result.modes[i];
     const double x0 = kLeft + static_cast<double>(i % kColumns) * (kPanel + kGap);
-    const double y0 = kTop + static_cast<double>(i / kColumns) * (kPanel + kGap);
+    const double y0 = kTop + static_cast<double>(i / kColumns) * (kPanel + kRowGap);
     const double cx = x0 + kPanel / 2, cy = y0 + kPanel / 2, per_um = kPanel / (2 * range_um);
     const Summary s = Summarize(m.errors_um);
+    svg += fmt::format("<!-- panel: {} -->\n", SimModeName(m.mode));
     svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", x0, y0 - 24,
-                       kModeColours[i], SimModeName(m.mode));
-    svg += m.placements == 0
-               ? fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">no part placed, {} cycles stopped</text>\n", x0, y0 - 8,
-                             m.faults)
-               : fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{:.2f}% within, p99 {:.0f} µm, {} cycles stopped</text>\n",
-                             x0, y0 - 8, 100 * WithinFraction(m), s.p99, m.faults);
+                       ModeColour(m.mode), SimModeName(m.mode));
+    if (m.placements == 0) {
+      // Nothing to scatter: no axes, the reason in the panel.
+      svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">nothing placed, {} of {} cycles stopped</text>\n", x0,
+                         y0 - 8, m.faults, m.cycles);
+      svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.0f}\" height=\"{:.0f}\" fill=\"#f4f4f4\" "
+                         "stroke=\"#bbb\" stroke-dasharray=\"4,3\"/>\n", x0, y0, kPanel, kPanel);
+      const std::vector<std::string> note = NothingPlacedNote(m);
+      double y = cy - 9 * static_cast<double>(note.size() - 1);
+      for (std::size_t k = 0; k < note.size(); ++k, y += 18) {
+        svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\"{}>{}</text>\n", cx, y,
+                           k == 0 ? " font-weight=\"bold\"" : "", SvgEscape(note[k]));
+      }
+      continue;
+    }
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{:.2f}% within, p99 {:.0f} µm, {} cycles stopped</text>\n",
+                       x0, y0 - 8, 100 * WithinFraction(m), s.p99, m.faults);
     svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.0f}\" height=\"{:.0f}\" fill=\"#fafafa\" "
                        "stroke=\"#999\"/>\n", x0, y0, kPanel, kPanel);
-    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n", x0, cy,
-                       x0 + kPanel, cy);
-    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>\n", cx, y0, cx,
-                       y0 + kPanel);
-    svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.35\">\n", kModeColours[i]);
+    // Grid and ticks at round micrometres; the zero lines darker.
+    for (double t : scatter_ticks) {
+      const double px = cx + t * per_um, py = cy - t * per_um;
+      const char* grid = std::fabs(t) < 1e-9 ? "#ccc" : "#eee";
+      svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>\n", px, y0,
+                         px, y0 + kPanel, grid);
+      svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\"/>\n", x0, py,
+                         x0 + kPanel, py, grid);
+      svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#666\"/>"
+                         "<text x=\"{0:.1f}\" y=\"{3:.1f}\" text-anchor=\"middle\" fill=\"#444\">{4}</text>\n",
+                         px, y0 + kPanel, y0 + kPanel + 4, y0 + kPanel + 16, SvgTickText(t, scatter_step_um));
+      svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{2:.1f}\" x2=\"{1:.1f}\" y2=\"{2:.1f}\" stroke=\"#666\"/>"
+                         "<text x=\"{3:.1f}\" y=\"{4:.1f}\" text-anchor=\"end\" fill=\"#444\">{5}</text>\n",
+                         x0 - 4, x0, py, x0 - 6, py + 4, SvgTickText(t, scatter_step_um));
+    }
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#444\">x error (µm)</text>\n",
+                       cx, y0 + kPanel + 32);
+    svg += fmt::format("<text x=\"{0:.1f}\" y=\"{1:.1f}\" text-anchor=\"middle\" fill=\"#444\" "
+                       "transform=\"rotate(-90 {0:.1f} {1:.1f})\">y error (µm)</text>\n",
+                       x0 - 40, cy);
+    svg += fmt::format("<g fill=\"{}\" fill-opacity=\"0.35\">\n", ModeColour(m.mode));
     std::string outside;
     for (const Eigen::Vector2d& e : m.scatter_um) {
       const double scale = std::max({std::abs(e.x()), std::abs(e.y()), range_um}) / range_um;
@@ -325,62 +387,86 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
       (scale > 1 ? outside : svg) += dot;
     }
     svg += "</g>\n";
-    if (m.placements == 0) {
-      svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">no part placed: every cycle "
-                         "stopped</text>\n<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">by a failed scan "
-                         "check</text>\n", cx, cy + 80, cx, cy + 96);
-    }
     if (!outside.empty()) svg += "<g fill=\"#d62728\">\n" + outside + "</g>\n";
     svg += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"{:.1f}\" fill=\"none\" stroke=\"black\" "
                        "stroke-dasharray=\"5,4\"/>\n", cx, cy, tolerance_um * per_um);
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#666\">x error (µm), "
-                       "±{:.0f}</text>\n", cx, y0 + kPanel + 16, range_um);
   }
-  // Histograms of the error lengths: the fraction of each mode's parts per bin.
+  // Histograms of the error lengths: the share of each mode's placed parts
+  // per bin, in percent; modes that placed nothing have no curve.
   constexpr int kBins = 60;
   const double hist_max_um = 3 * tolerance_um, bin_um = hist_max_um / kBins;
-  const double hx0 = kLeft, hw = width - kLeft - kGap - 150;
-  std::vector<std::vector<double>> fractions;
-  double top_fraction = 0;
+  const double hx0 = kLeft, hw = width - kLeft - kGap - 170;
+  std::vector<std::vector<double>> shares;  // percent
+  double top_share = 0;
   for (const ModeResult& m : result.modes) {
     std::vector<double> bins(kBins, 0.0);
     for (double e : m.errors_um) bins[std::min(kBins - 1, static_cast<int>(e / bin_um))] += 1;
-    for (double& b : bins) b = m.errors_um.empty() ? 0 : b / static_cast<double>(m.errors_um.size());
-    top_fraction = std::max(top_fraction, *std::max_element(bins.begin(), bins.end()));
-    fractions.push_back(bins);
+    for (double& b : bins) b = m.errors_um.empty() ? 0 : 100 * b / static_cast<double>(m.errors_um.size());
+    top_share = std::max(top_share, *std::max_element(bins.begin(), bins.end()));
+    shares.push_back(bins);
   }
-  if (top_fraction <= 0) top_fraction = 1;
-  svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" font-weight=\"bold\">Error length histogram (fraction of placed "
-                     "parts per {:.0f} µm bin; the last bin holds everything beyond)</text>\n",
-                     hx0, hist_top - 10, bin_um);
+  if (top_share <= 0) top_share = 1;
+  const double share_step = SvgTickStep(top_share, 5);
+  const double share_max = std::ceil(top_share / share_step * (1 - 1e-12)) * share_step;
+  svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" font-weight=\"bold\">Error length histogram (share of each mode's "
+                     "placed parts per {:g} µm bin; the last bin holds everything beyond)</text>\n",
+                     hx0, hist_top - 14, bin_um);
   svg += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"#fafafa\" "
                      "stroke=\"#999\"/>\n", hx0, hist_top, hw, hist_height);
+  for (double t : SvgTicks(0, share_max, share_step)) {
+    const double y = hist_top + hist_height * (1 - t / share_max);
+    if (t > 0) {
+      svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#eee\"/>\n", hx0, y,
+                         hx0 + hw, y);
+    }
+    svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#666\"/>"
+                       "<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\" fill=\"#444\">{}%</text>\n",
+                       hx0 - 4, y, hx0, y, hx0 - 6, y + 4, SvgTickText(t, share_step));
+  }
+  svg += fmt::format("<text x=\"{0:.1f}\" y=\"{1:.1f}\" text-anchor=\"middle\" fill=\"#444\" "
+                     "transform=\"rotate(-90 {0:.1f} {1:.1f})\">share of placed parts (%)</text>\n",
+                     hx0 - 46, hist_top + hist_height / 2);
   const double tol_x = hx0 + hw * tolerance_um / hist_max_um;
   svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"black\" "
                      "stroke-dasharray=\"5,4\"/>\n<text x=\"{:.1f}\" y=\"{:.1f}\">tolerance</text>\n",
                      tol_x, hist_top, tol_x, hist_top + hist_height, tol_x + 4, hist_top + 14);
-  for (int tick = 0; tick <= 6; ++tick) {
-    const double um = hist_max_um * tick / 6;
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#666\">{:.0f} µm</text>\n",
-                       hx0 + hw * tick / 6, hist_top + hist_height + 16, um);
+  const double length_step = SvgTickStep(hist_max_um, 6);
+  for (double um : SvgTicks(0, hist_max_um, length_step)) {
+    const double x = hx0 + hw * um / hist_max_um;
+    svg += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#666\"/>"
+                       "<text x=\"{0:.1f}\" y=\"{3:.1f}\" text-anchor=\"middle\" fill=\"#444\">{4}</text>\n",
+                       x, hist_top + hist_height, hist_top + hist_height + 4, hist_top + hist_height + 16,
+                       SvgTickText(um, length_step));
   }
-  for (std::size_t i = 0; i < fractions.size(); ++i) {
+  svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" fill=\"#444\">error length "
+                     "(µm)</text>\n", hx0 + hw / 2, hist_top + hist_height + 34);
+  if (std::all_of(result.modes.begin(), result.modes.end(), [](const ModeResult& m) { return m.placements == 0; })) {
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-weight=\"bold\">no mode "
+                       "placed a part: nothing to count</text>\n", hx0 + hw / 2, hist_top + hist_height / 2);
+  }
+  for (std::size_t i = 0; i < shares.size(); ++i) {
+    const ModeResult& m = result.modes[i];
+    const double ly = hist_top + 14 + 20 * static_cast<double>(i);
+    if (m.placements == 0) {
+      svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" fill=\"#888\">{} (nothing placed)</text>\n", hx0 + hw + 42,
+                         ly, SimModeName(m.mode));
+      continue;
+    }
     std::string points;
     for (int b = 0; b < kBins; ++b) {
-      const double y = hist_top + hist_height * (1 - fractions[i][b] / top_fraction);
+      const double y = hist_top + hist_height * (1 - shares[i][b] / share_max);
       points += fmt::format("{:.1f},{:.1f} {:.1f},{:.1f} ", hx0 + hw * b / kBins, y, hx0 + hw * (b + 1) / kBins, y);
     }
     svg += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n", points,
-                       kModeColours[i]);
-    const double ly = hist_top + 14 + 20 * static_cast<double>(i);
+                       ModeColour(m.mode));
     svg += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"{}\" "
                        "stroke-width=\"3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
-                       hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, kModeColours[i], hx0 + hw + 42, ly,
-                       SimModeName(result.modes[i].mode));
+                       hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, ModeColour(m.mode), hx0 + hw + 42, ly,
+                       SimModeName(m.mode));
   }
   for (std::size_t i = 0; i < truth_lines.size(); ++i) {
     svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" fill=\"#666\">{}</text>\n", kLeft,
-                       hist_top + hist_height + 50 + 16 * static_cast<double>(i), truth_lines[i]);
+                       hist_top + hist_height + 64 + 16 * static_cast<double>(i), SvgEscape(truth_lines[i]));
   }
   svg += "</svg>\n";
   return svg;

@@ -1,9 +1,14 @@
 // Text inside the SVG pictures smtcal writes (table plots, diff arrows): file
-// names and point names may hold the characters XML reserves.
+// names and point names may hold the characters XML reserves; and the round
+// numbers an axis is ticked at.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "base/field_text.h"
 
@@ -33,6 +38,38 @@ inline std::string SvgEscape(std::string_view text) {
     i += length;
   }
   return out;
+}
+
+// The tick step of an axis spanning `span` (> 0) with at most about
+// `max_ticks` ticks: the smallest 1, 2, 2.5 or 5 times a power of ten that
+// gives no more.
+inline double SvgTickStep(double span, int max_ticks) {
+  const double rough = span / max_ticks;
+  const double power = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double m : {1.0, 2.0, 2.5, 5.0}) {
+    if (m * power >= rough * (1 - 1e-12)) return m * power;
+  }
+  return 10 * power;
+}
+
+// The multiples of `step` in [lo, hi] (a hair of slack at both ends).
+inline std::vector<double> SvgTicks(double lo, double hi, double step) {
+  std::vector<double> ticks;
+  const double slack = 1e-9 * step;
+  for (double k = std::ceil((lo - slack) / step); k * step <= hi + slack; k += 1) ticks.push_back(k * step);
+  return ticks;
+}
+
+// A tick's label: as many decimals as the step needs (step 2.5 -> 1), no "-0".
+inline std::string SvgTickText(double value, double step) {
+  int decimals = 0;
+  while (decimals < 6 && std::fabs(step * std::pow(10.0, decimals) - std::round(step * std::pow(10.0, decimals))) >
+                             1e-9 * std::pow(10.0, decimals)) {
+    ++decimals;
+  }
+  std::string text = fmt::format("{:.{}f}", value, decimals);
+  if (text.find_first_not_of("-0.") == std::string::npos && text.front() == '-') text.erase(0, 1);
+  return text;
 }
 
 }  // namespace smtcal

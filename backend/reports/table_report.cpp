@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "base/field_text.h"
 #include "base/json_text.h"
 
 namespace smtcal {
@@ -26,10 +27,7 @@ std::string SignedFixed(double v, int decimals) {
 
 // JSON numbers: rounded to a nanometre (or 1e-6 for ratios) so they print
 // short and the same everywhere.
-double Round6(double v) {
-  double r = std::round(v * 1e6) / 1e6;
-  return r == 0 ? 0.0 : r;
-}
+double Round6(double v) { return RoundedToDecimals(v, 6); }
 
 std::string Range(const std::vector<double>& lines) {
   return fmt::format("{}..{}", FormatMm(lines.front()), FormatMm(lines.back()));

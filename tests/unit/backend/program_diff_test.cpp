@@ -8,12 +8,15 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <random>
+#include <regex>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "backend/diff/diff_report.h"
 #include "backend/diff/program_diff.h"
@@ -336,6 +339,144 @@ TEST(DiffPrograms, OutputIsDeterministic) {
   EXPECT_EQ(svg, PlotDiffSvg(second->diff));
   EXPECT_EQ(svg.rfind("<svg ", 0), 0u);
   EXPECT_NE(svg.find("times enlarged"), std::string::npos);
+}
+
+// ------------------------------------------------------------------ JSON and SVG
+
+// The decimals a JSON number is written with ("2.9e-05" has 6).
+int Decimals(const nlohmann::json& number) {
+  const std::string text = number.dump();
+  const std::size_t e = text.find_first_of("eE");
+  const std::string mantissa = text.substr(0, e);
+  const std::size_t dot = mantissa.find('.');
+  int decimals = dot == std::string::npos ? 0 : static_cast<int>(mantissa.size() - dot - 1);
+  if (e != std::string::npos) decimals -= std::stoi(text.substr(e + 1));
+  return std::max(decimals, 0);
+}
+
+// Calls `check(key, number)` for every floating-point number in `json`.
+void ForEachNumber(const nlohmann::json& json, const std::string& key,
+                   const std::function<void(const std::string&, const nlohmann::json&)>& check) {
+  if (json.is_object()) {
+    for (const auto& [k, v] : json.items()) ForEachNumber(v, k, check);
+  } else if (json.is_array()) {
+    for (const nlohmann::json& v : json) ForEachNumber(v, key, check);
+  } else if (json.is_number_float()) {
+    check(key, json);
+  }
+}
+
+TEST(DiffJson, NumbersCarryTheirDecimalsOnly) {
+  // R1 moves 1 mm back along x and 0.274 µm up: toward 179.9843° (as
+  // 1799843 * 1e-4 the double is 179.98430000000002).
+  auto run = RunDiff(kProgram, Replace(kProgram, "XY(5.0, 7.0, -3.0, 0.0) In Layer",
+                                       "XY(4.0, 7.000274, -3.0, 0.05) In Layer"));
+  const nlohmann::json json = nlohmann::json::parse(FormatDiffJson(run->diff));
+  int numbers = 0;
+  ForEachNumber(json, "", [&](const std::string& key, const nlohmann::json& number) {
+    ++numbers;
+    EXPECT_LE(Decimals(number), key == "du_deg" ? 7 : 4) << key << " " << number.dump();
+  });
+  EXPECT_GT(numbers, 10);
+  EXPECT_NE(FormatDiffJson(run->diff).find("\"direction_deg\": 179.9843\n"), std::string::npos)
+      << FormatDiffJson(run->diff);
+}
+
+// R1's Place depends on a run-time offset: compared, but not drawn.
+std::unique_ptr<DiffRun> RunTimeOffsetDiff() {
+  std::string with_var = Replace(kProgram, "Function Main\n", "Real dx\n\nFunction Main\n");
+  with_var = Replace(with_var, "    Place R1\n", "    Place R1 + X(dx)\n");
+  return RunDiff(with_var, Replace(with_var, "XY(160.0, 10.0,", "XY(160.02, 10.01,"));
+}
+
+TEST(DiffSvg, CountsAgreeWithTheTextAndJson) {
+  auto run = RunTimeOffsetDiff();
+  const std::size_t compared = nlohmann::json::parse(FormatDiffJson(run->diff))["summary"]["targets_compared"];
+  ASSERT_EQ(compared, 6u);  // Feed, R1, S1, Pick, Place, Jump
+  EXPECT_NE(FormatDiffText(run->diff).find("6 targets compared"), std::string::npos);
+  const std::string svg = PlotDiffSvg(run->diff);
+  EXPECT_NE(svg.find(">6 targets compared (as in the text report): 4 in the robot base frame, 1 in the fixture "
+                     "Board's frame, 1 not drawn</text>"),
+            std::string::npos)
+      << svg;
+  // Each panel's count is of the same targets, and they add up.
+  const std::regex panel_count(R"(>(\d+) of the (\d+) compared targets)");
+  std::size_t drawn = 0, panels = 0;
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), panel_count); it != std::sregex_iterator(); ++it) {
+    EXPECT_EQ(std::stoul((*it)[2]), compared);
+    drawn += std::stoul((*it)[1]);
+    ++panels;
+  }
+  EXPECT_EQ(panels, 2u);
+  EXPECT_EQ(drawn + 1, compared);
+}
+
+TEST(DiffSvg, PanelsNameTheirFrameAndTickInMillimetres) {
+  auto run = RunTimeOffsetDiff();
+  const std::string svg = PlotDiffSvg(run->diff);
+  EXPECT_NE(svg.find(">robot base frame, mm</text>"), std::string::npos) << svg;
+  EXPECT_NE(svg.find(">fixture Board's frame, mm</text>"), std::string::npos);
+  std::size_t x_labels = 0, y_labels = 0;
+  for (std::size_t at = svg.find(">x (mm)</text>"); at != std::string::npos; at = svg.find(">x (mm)</text>", at + 1)) {
+    ++x_labels;
+  }
+  for (std::size_t at = svg.find(">y (mm)</text>"); at != std::string::npos; at = svg.find(">y (mm)</text>", at + 1)) {
+    ++y_labels;
+  }
+  EXPECT_EQ(x_labels, 2u);
+  EXPECT_EQ(y_labels, 2u);
+  // Round ticks: in the base panel (Feed at x 160, S1 at 298) every 25 mm.
+  for (const char* tick : {">150</text>", ">175</text>", ">275</text>", ">300</text>"}) {
+    EXPECT_NE(svg.find(tick), std::string::npos) << tick << "\n" << svg;
+  }
+}
+
+// Eight neighbouring targets 1 mm apart all move; the labels of the five
+// largest must stay inside the frame and off each other.
+TEST(DiffSvg, LabelsStayInsideTheFrameAndApart) {
+  std::string points, moved, uses;
+  for (int k = 0; k < 8; ++k) {
+    points += fmt::format("Point P{} = XY({}.0, 10.0, -3.0, 0.0)\n", k, 100 + k);
+    moved += fmt::format("Point P{} = XY({}, {}, -3.0, 0.0)\n", k, 100 + k + 0.01 + 0.002 * k, 10.0 + 0.01);
+    uses += fmt::format("  Jump P{}\n", k);
+  }
+  const std::string head = "Program L\nUnits mm\nPoint Far = XY(300.0, 200.0, -3.0, 0.0)\n";
+  const std::string tail = "\nFunction Main\n" + uses + "  Jump Far\nFend\n";
+  auto run = RunDiff(head + points + tail, head + moved + tail);
+  const std::string svg = PlotDiffSvg(run->diff);
+  const std::regex frame_re(
+      R"re(<rect x="([\d.]+)" y="([\d.]+)" width="([\d.]+)" height="([\d.]+)" fill="none" stroke="#999"/>)re");
+  std::smatch frame;
+  ASSERT_TRUE(std::regex_search(svg, frame, frame_re)) << svg;
+  const double fx = std::stod(frame[1]), fy = std::stod(frame[2]);
+  const double fw = std::stod(frame[3]), fh = std::stod(frame[4]);
+  // The label boxes as the plot estimates them: 0.56 em per character, the
+  // anchor at the start, middle or end.
+  struct Box {
+    double x0, y0, x1, y1;
+  };
+  std::vector<Box> boxes;
+  const std::regex label_re(
+      R"re(<text x="([\d.]+)" y="([\d.]+)" font-size="11"(?: text-anchor="(end|middle)")?>([^<]*)</text>)re");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), label_re); it != std::sregex_iterator(); ++it) {
+    const std::string text = (*it)[4];
+    std::size_t chars = 0;
+    for (unsigned char c : text) chars += (c & 0xC0) != 0x80;
+    const double width = 0.56 * 11 * static_cast<double>(chars);
+    const double x = std::stod((*it)[1]), y = std::stod((*it)[2]);
+    const std::string anchor = (*it)[3];
+    const double x0 = anchor == "end" ? x - width : anchor == "middle" ? x - width / 2 : x;
+    boxes.push_back({x0, y - 9, x0 + width, y + 2});
+  }
+  ASSERT_EQ(boxes.size(), 5u) << svg;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const Box& b = boxes[i];
+    EXPECT_TRUE(b.x0 >= fx && b.x1 <= fx + fw && b.y0 >= fy && b.y1 <= fy + fh) << "label " << i << " leaves the frame";
+    for (std::size_t j = 0; j < i; ++j) {
+      const Box& o = boxes[j];
+      EXPECT_FALSE(b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1) << "labels " << j << " and " << i;
+    }
+  }
 }
 
 // ------------------------------------------------------------------ the command

@@ -6,11 +6,15 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include "base/diagnostics.h"
+#include "base/field_text.h"
 #include "base/json_text.h"
 #include "base/source.h"
 #include "tests/unit/test_support.h"
@@ -78,6 +82,28 @@ TEST(Json, TextThatIsNotUtf8IsReplacedNotThrown) {
   EXPECT_EQ(JsonText(json), "{\n  \"file\": \"lay\xef\xbf\xbd.place\"\n}\n");
   nlohmann::json plain = {{"file", std::string("\xc3")}};
   EXPECT_EQ(JsonText(plain), "{\n  \"file\": \"\xef\xbf\xbd\"\n}\n");
+}
+
+TEST(Json, NumbersAreWrittenWithTheirShortestDigits) {
+  // nlohmann's Grisu2 writes 0.059409 as 0.059408999999999997.
+  EXPECT_EQ(JsonText(nlohmann::json(RoundedToDecimals(0.0594090001, 6))), "0.059409\n");
+  EXPECT_EQ(JsonText(nlohmann::ordered_json({{"a", 0.059409}})), "{\n  \"a\": 0.059409\n}\n");
+  // Otherwise nlohmann's spelling: ".0" on integral values, plain from 1e-4
+  // to below 1e15, an exponent of at least two digits beyond.
+  const std::vector<std::pair<double, std::string>> cases = {
+      {0.0, "0.0"},        {-0.0, "-0.0"},         {1.0, "1.0"},
+      {-12.0, "-12.0"},    {179.9843, "179.9843"}, {0.0001, "0.0001"},
+      {1e-05, "1e-05"},    {2.9e-05, "2.9e-05"},   {-4.1e-11, "-4.1e-11"},
+      {1e14, "100000000000000.0"}, {1e15, "1e+15"}, {1.2345678901234568e+17, "1.2345678901234568e+17"},
+      {1e300, "1e+300"},   {0.1 + 0.2, "0.30000000000000004"}};
+  for (const auto& [value, text] : cases) {
+    EXPECT_EQ(JsonText(nlohmann::json(value)), text + "\n") << text;
+    EXPECT_EQ(nlohmann::json(value).dump(), text) << "nlohmann spells " << text << " so";
+  }
+  // Integers, and digits in strings and keys, as they are.
+  EXPECT_EQ(JsonText(nlohmann::ordered_json({{"1.50", "x 1.50e3"}, {"n", 42}, {"m", -7}})),
+            "{\n  \"1.50\": \"x 1.50e3\",\n  \"n\": 42,\n  \"m\": -7\n}\n");
+  EXPECT_EQ(JsonText(nlohmann::json("a \"quoted\" 0.10")), "\"a \\\"quoted\\\" 0.10\"\n");
 }
 
 // The caret column of each rendered snippet: the display column of '^' in
