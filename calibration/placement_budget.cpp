@@ -100,6 +100,21 @@ Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatabili
 }
 
 ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm) {
+  return StaticBudget(cell, region, residual_mm,
+                      region != nullptr ? TableStandardErrorMm(region->table, cell.robot.repeatability_mm)
+                                        : Eigen::Vector2d::Zero());
+}
+
+std::vector<Eigen::Vector2d> RegionTableNoise(const cell::Cell& cell) {
+  std::vector<Eigen::Vector2d> noise;
+  for (const cell::Region& region : cell.regions) {
+    noise.push_back(TableStandardErrorMm(region.table, cell.robot.repeatability_mm));
+  }
+  return noise;
+}
+
+ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm,
+                         const Eigen::Vector2d& table_se) {
   ErrorBudget budget;
   const double r = cell.robot.repeatability_mm;
   ErrorShare& residual = budget[ErrorSource::kResidual];
@@ -108,7 +123,7 @@ ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, dou
   repeat.covariance_mm2 = UniformVariance(r) * Eigen::Matrix2d::Identity();
   repeat.worst_mm = r * std::numbers::sqrt2;
   if (region != nullptr) {
-    const Eigen::Vector2d se = TableStandardErrorMm(region->table, r);
+    const Eigen::Vector2d& se = table_se;
     ErrorShare& table = budget[ErrorSource::kTable];
     table.covariance_mm2 = se.cwiseAbs2().asDiagonal();
     table.worst_mm = kBudgetSigmas * se.norm();
@@ -131,7 +146,8 @@ std::vector<int> TripRegions(const cell::Fixture& fixture, const std::vector<cel
 FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture& fixture)
     : cell_(cell),
       sensor_accuracy_mm_(fixture.sensor_accuracy_mm),
-      latency_mm_(fixture.scan_speed_mm_s * cell.robot.servo_period_s) {
+      latency_mm_(fixture.scan_speed_mm_s * cell.robot.servo_period_s),
+      region_table_se_(RegionTableNoise(cell)) {
   trip_regions_ = TripRegions(fixture, cell.regions);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const Eigen::Affine3d nominal = NominalFix(fixture);
@@ -174,7 +190,10 @@ std::vector<std::size_t> FixtureErrorModel::UncalibratedTrips() const {
 
 ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const cell::Region* region,
                                   double residual_mm) const {
-  ErrorBudget budget = StaticBudget(cell_, region, residual_mm);
+  ErrorBudget budget =
+      region != nullptr
+          ? StaticBudget(cell_, region, residual_mm, region_table_se_[static_cast<std::size_t>(region - cell_.regions.data())])
+          : StaticBudget(cell_, region, residual_mm);
   if (!defined_) {
     budget.bounded = false;
     return budget;

@@ -95,6 +95,13 @@ Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatabili
 // target): the residual, the repeatability, the table's noise. `region` may
 // be null (then only the repeatability).
 ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm);
+// The same with the region's TableStandardErrorMm given: a compile asks for
+// every target's budget, so the tables' noise is found once (RegionTableNoise).
+ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm,
+                         const Eigen::Vector2d& table_se);
+
+// TableStandardErrorMm of every region of the cell, in the cell's order.
+std::vector<Eigen::Vector2d> RegionTableNoise(const cell::Cell& cell);
 
 // Which region calibrates each trip of the fixture's scan whatever pose the
 // checks let through: the first region whose table domain holds the trip's
@@ -130,6 +137,7 @@ class FixtureErrorModel {
   std::vector<Eigen::Vector2d> d_origin_;
   std::vector<double> leg_across_;    // |leg direction . edge normal|: the latency's share across the edge
   std::vector<double> trip_table_se_;  // the calibrating table's standard error across the edge; 0 if none
+  std::vector<Eigen::Vector2d> region_table_se_;  // RegionTableNoise of the cell
 };
 
 // The probability that a placement with error mean `mean_mm` and a normal

@@ -77,7 +77,10 @@ ErrorBudget CompileState::BudgetOf(const Target& target) const {
     return ErrorModelFor(*fixtures[target.fixture].cell_fixture).At(Xy(target.in_frame), target.region,
                                                                      target.residual_mm);
   }
-  return StaticBudget(*cell, target.region, target.residual_mm);
+  if (target.region == nullptr) return StaticBudget(*cell, nullptr, target.residual_mm);
+  if (region_table_se_.empty()) region_table_se_ = RegionTableNoise(*cell);
+  return StaticBudget(*cell, target.region, target.residual_mm,
+                      region_table_se_[static_cast<std::size_t>(target.region - cell->regions.data())]);
 }
 
 std::string_view TargetKeyword(const ir::Stmt& stmt) {
