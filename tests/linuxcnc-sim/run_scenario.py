@@ -29,6 +29,7 @@
 # Exit 0: passed; 1: failed; 77: skipped (LinuxCNC or namespaces cannot
 # start here; the message says why).
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -144,7 +145,7 @@ def derive_ini(work, program_dir, dry_run):
             section = stripped
         key = stripped.split("=", 1)[0].strip() if "=" in stripped and not stripped.startswith("#") else ""
         if section == "[DISPLAY]" and key == "DISPLAY":
-            line = "DISPLAY = " + os.path.join(HERE, "driver.py")
+            line = "DISPLAY = " + os.path.join(work, "driver.py")
         elif section == "[DISPLAY]" and key in ("INTRO_GRAPHIC", "INTRO_TIME"):
             continue  # popimage needs X
         elif section == "[RS274NGC]" and key == "SUBROUTINE_PATH":
@@ -153,8 +154,11 @@ def derive_ini(work, program_dir, dry_run):
                 line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
-            out.append("HALFILE = " + os.path.join(HERE, "marker-sensor.hal"))
+            out.append("HALFILE = " + os.path.join(work, "marker-sensor.hal"))
     ini = os.path.join(work, "sim.ini")
+    # LinuxCNC reads nothing outside the scenario's folder (see work_root).
+    for name in ("driver.py", "marker-sensor.hal"):
+        shutil.copy(os.path.join(HERE, name), work)
     open(ini, "w").write("\n".join(out) + "\n")
     for name in ("paper-cell.hal", "paper-cell.tbl", "paper-cell.var"):
         shutil.copy(os.path.join(EXAMPLE, name), work)
@@ -216,11 +220,23 @@ f.flush()
 """
 
 
+def work_root(path):
+    """Where the scenarios run. LinuxCNC runs with a private /tmp bound over
+    the system's, which hides everything below /tmp: a build under /tmp (a
+    clone there) runs its scenarios under /var/tmp instead, in a folder named
+    after the build's."""
+    path = os.path.abspath(path)
+    if path != "/tmp" and not path.startswith("/tmp/"):
+        return path
+    digest = hashlib.sha1(path.encode()).hexdigest()[:12]
+    return os.path.join("/var/tmp", "smtcal-linuxcnc-sim-%d" % os.getuid(), digest)
+
+
 def headless_example(args):
     """paper-cell-headless.ini as shipped, driven through linuxcncrsh as the README says."""
     if shutil.which("ip") is None or shutil.which("linuxcncrsh") is None:
         skip("'ip' (iproute2) or 'linuxcncrsh' (linuxcnc-uspace) is not installed (tools/install-deps.sh)")
-    work = os.path.join(os.path.abspath(args.work), args.scenario)
+    work = os.path.join(work_root(args.work), args.scenario)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     for name in os.listdir(EXAMPLE):
@@ -318,14 +334,12 @@ def main():
     parser.add_argument("scenario", choices=sorted(SCENARIOS) + ["headless_example"])
     args = parser.parse_args()
     check_prerequisites()
-    if os.path.abspath(args.work).startswith("/tmp/"):
-        fail("--work must not be under /tmp: each run mounts its own /tmp over it")
     if args.scenario == "headless_example":
         return headless_example(args)
     scenario = SCENARIOS[args.scenario]
     started = time.monotonic()
 
-    work = os.path.join(os.path.abspath(args.work), args.scenario)
+    work = os.path.join(work_root(args.work), args.scenario)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     cell = CELL
