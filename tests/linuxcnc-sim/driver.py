@@ -73,6 +73,14 @@ def main():
     def now():
         return round(time.monotonic() - started, 4)
 
+    def drain_messages():
+        """Every operator message LinuxCNC has queued, with the cycle it came in."""
+        message = errors.poll()
+        while message:
+            record["messages"].append({"t": now(), "kind": message[0], "text": message[1],
+                                       "cycle": len(record["cycles"]) - 1})
+            message = errors.poll()
+
     def save(end):
         record["end"] = end
         record["times"]["total_s"] = now()
@@ -124,11 +132,7 @@ def main():
             command.abort()
             break
         stat.poll()
-        message = errors.poll()
-        while message:
-            record["messages"].append({"t": now(), "kind": message[0], "text": message[1],
-                                       "cycle": len(record["cycles"]) - 1})
-            message = errors.poll()
+        drain_messages()
         # A probe move's result: motion's latched position changes (the
         # tripped flag alone falls back when the next move starts).
         probe = tuple(stat.probed_position[:3])
@@ -171,11 +175,7 @@ def main():
     # Let the last status and messages arrive.
     time.sleep(0.2)
     stat.poll()
-    message = errors.poll()
-    while message:
-        record["messages"].append({"t": now(), "kind": message[0], "text": message[1],
-                                   "cycle": len(record["cycles"]) - 1})
-        message = errors.poll()
+    drain_messages()
     record["final_dout"] = {str(VACUUM_OUT): bool(stat.dout[VACUUM_OUT])}
     save(end)
 

@@ -22,6 +22,7 @@
 #include "backend/diff/program_diff.h"
 #include "frontend/parse.h"
 #include "passes/pass_manager.h"
+#include "tests/unit/json_walk.h"
 #include "tests/unit/test_support.h"
 
 namespace smtcal::diff {
@@ -354,18 +355,6 @@ int Decimals(const nlohmann::json& number) {
   return std::max(decimals, 0);
 }
 
-// Calls `check(key, number)` for every floating-point number in `json`.
-void ForEachNumber(const nlohmann::json& json, const std::string& key,
-                   const std::function<void(const std::string&, const nlohmann::json&)>& check) {
-  if (json.is_object()) {
-    for (const auto& [k, v] : json.items()) ForEachNumber(v, k, check);
-  } else if (json.is_array()) {
-    for (const nlohmann::json& v : json) ForEachNumber(v, key, check);
-  } else if (json.is_number_float()) {
-    check(key, json);
-  }
-}
-
 TEST(DiffJson, NumbersCarryTheirDecimalsOnly) {
   // R1 moves 1 mm back along x and 0.274 µm up: toward 179.9843° (as
   // 1799843 * 1e-4 the double is 179.98430000000002).
@@ -373,7 +362,7 @@ TEST(DiffJson, NumbersCarryTheirDecimalsOnly) {
                                        "XY(4.0, 7.000274, -3.0, 0.05) In Layer"));
   const nlohmann::json json = nlohmann::json::parse(FormatDiffJson(run->diff));
   int numbers = 0;
-  ForEachNumber(json, "", [&](const std::string& key, const nlohmann::json& number) {
+  test::ForEachNumber(json, "", [&](const std::string& key, const nlohmann::json& number) {
     ++numbers;
     EXPECT_LE(Decimals(number), key == "du_deg" ? 7 : 4) << key << " " << number.dump();
   });

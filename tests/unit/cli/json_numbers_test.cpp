@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/unit/json_walk.h"
 #include "tests/unit/test_support.h"
 
 namespace smtcal {
@@ -41,24 +42,11 @@ int Decimals(double value) {
   return std::max(digits - std::stoi(text.substr(e + 1)), 0);
 }
 
-// Calls `check(key, number)` for every floating-point number, `key` being
-// the name of the member it is in (arrays pass their member's name down).
-void ForEachNumber(const nlohmann::json& json, const std::string& key,
-                   const std::function<void(const std::string&, const nlohmann::json&)>& check) {
-  if (json.is_object()) {
-    for (const auto& [k, v] : json.items()) ForEachNumber(v, k, check);
-  } else if (json.is_array()) {
-    for (const nlohmann::json& v : json) ForEachNumber(v, key, check);
-  } else if (json.is_number_float()) {
-    check(key, json);
-  }
-}
-
 void ExpectRounded(const std::string& what, const std::string& text) {
   SCOPED_TRACE(what);
   ASSERT_TRUE(nlohmann::json::accept(text)) << text;
   int numbers = 0;
-  ForEachNumber(nlohmann::json::parse(text), "", [&](const std::string& key, const nlohmann::json& number) {
+  test::ForEachNumber(nlohmann::json::parse(text), "", [&](const std::string& key, const nlohmann::json& number) {
     if (key == "matrix") return;
     ++numbers;
     EXPECT_LE(Decimals(number.get<double>()), kMaxDecimals) << key << ": " << number.get<double>();
