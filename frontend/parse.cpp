@@ -667,7 +667,7 @@ bool Session::IfHasBlock(std::size_t if_line) const {
 // objects are made once and reused for every line, so a line costs no
 // allocation per token (CommonTokenStream over a TokenSource would make and
 // free one 112-byte object per token, the largest cost of a parse).
-class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
+class LineTokens final : public antlr4::TokenStream, public antlr4::TokenSource {
  public:
   explicit LineTokens(const Session& session) : session_(session) {}
 
@@ -699,7 +699,10 @@ class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
     if (LA(1) == Token::EOF) throw antlr4::IllegalStateException("cannot consume EOF");
     ++p_;
   }
+  // The parser asks LA(1) before every decision: answered from types_,
+  // without a virtual call to the token.
   std::size_t LA(ssize_t i) override {
+    if (i > 0) return types_[std::min(p_ + static_cast<std::size_t>(i) - 1, size_ - 1)];
     Token* token = LT(i);
     return token != nullptr ? token->getType() : Token::INVALID_TYPE;
   }
@@ -741,13 +744,18 @@ class LineTokens : public antlr4::TokenStream, public antlr4::TokenSource {
   };
 
   void Set(const PlaceToken& from, std::size_t type) {
-    if (size_ == tokens_.size()) tokens_.push_back(std::make_unique<Reused>(this));
+    if (size_ == tokens_.size()) {
+      tokens_.push_back(std::make_unique<Reused>(this));
+      types_.push_back(Token::INVALID_TYPE);
+    }
     tokens_[size_]->Fill(from, session_.Column(from), type, size_);
+    types_[size_] = type;
     ++size_;
   }
 
   const Session& session_;
   std::vector<std::unique_ptr<Reused>> tokens_;  // [0, size_) are this line's
+  std::vector<std::size_t> types_;               // their types
   std::size_t size_ = 0;
   std::size_t p_ = 0;
 };

@@ -21,6 +21,7 @@ struct CompileState;  // passes/correction/compile_state.h
 }
 namespace smtcal::sema {
 class SymbolTable;  // ir/symbols.h
+struct Symbol;
 }
 
 namespace smtcal::ir {
@@ -82,6 +83,13 @@ struct PointOffset {  // + X(d), - U(d), ...
 struct NamedPoint {
   std::string name;
   std::uint32_t length = 1;
+  // What the name was last found as, and by which symbol table (its
+  // SymbolTable::id(); 0: never): sema::SymbolTable::Find(NamedPoint) fills
+  // it, so that the passes after the first reach a placement's point
+  // without a hash lookup. Not part of the program (a table trusts only its
+  // own id); a pass that changes `name` sets symbol_table to 0.
+  mutable const sema::Symbol* symbol = nullptr;
+  mutable std::uint64_t symbol_table = 0;
 };
 struct PalletPoint {  // Pallet(n, i, j) or Pallet(n, k)
   ExprPtr number;

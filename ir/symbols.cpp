@@ -1,7 +1,9 @@
 #include "ir/symbols.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <utility>
 
 namespace smtcal::sema {
 namespace {
@@ -45,6 +47,45 @@ std::size_t NameHash::operator()(std::string_view name) const {
   return hash;
 }
 
+// ------------------------------------------------------------------ NameIndex
+
+std::size_t NameIndex::SlotOf(std::string_view name, std::size_t hash) const {
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = hash & mask;; i = (i + 1) & mask) {
+    const Slot& slot = slots_[i];
+    if (slot.symbol == nullptr || (slot.hash == hash && SameName(slot.symbol->name, name))) return i;
+  }
+}
+
+const Symbol* NameIndex::Find(std::string_view name) const {
+  if (slots_.empty()) return nullptr;
+  return slots_[SlotOf(name, NameHash{}(name))].symbol;
+}
+
+const Symbol* NameIndex::Insert(const Symbol& symbol) {
+  if ((count_ + 1) * 2 > slots_.size()) Reserve(count_ + 1);
+  const std::size_t hash = NameHash{}(symbol.name);
+  Slot& slot = slots_[SlotOf(symbol.name, hash)];
+  if (slot.symbol != nullptr) return slot.symbol;
+  slot = Slot{hash, &symbol};
+  ++count_;
+  return nullptr;
+}
+
+void NameIndex::Reserve(std::size_t names) {
+  std::size_t size = 16;
+  while (size < names * 2) size *= 2;
+  if (size <= slots_.size()) return;
+  std::vector<Slot> old = std::exchange(slots_, std::vector<Slot>(size));
+  const std::size_t mask = size - 1;
+  for (const Slot& slot : old) {
+    if (slot.symbol == nullptr) continue;
+    std::size_t i = slot.hash & mask;
+    while (slots_[i].symbol != nullptr) i = (i + 1) & mask;
+    slots_[i] = slot;
+  }
+}
+
 SourceRange NameAt(SourceLoc loc, std::string_view name) {
   return SourceRange(loc, static_cast<std::uint32_t>(name.size()));
 }
@@ -73,7 +114,10 @@ std::vector<Symbol> VariablesDeclaredBy(const ir::Stmt& stmt, bool global) {
 // ------------------------------------------------------------------ SymbolTable
 
 SymbolTable SymbolTable::Build(const ir::Program& program) {
+  static std::atomic<std::uint64_t> last_id{0};
   SymbolTable table;
+  table.id_ = ++last_id;
+  table.by_name_.Reserve(program.items.size());
   auto named = [&](SymbolKind kind, const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
     Symbol symbol;
     symbol.kind = kind;
@@ -110,18 +154,21 @@ SymbolTable SymbolTable::Build(const ir::Program& program) {
 }
 
 void SymbolTable::Add(Symbol symbol) {
-  auto it = by_name_.find(std::string_view(symbol.name));
-  if (it != by_name_.end()) {
-    duplicates_.push_back({*it->second, std::move(symbol)});
+  if (const Symbol* first = by_name_.Find(symbol.name)) {
+    duplicates_.push_back({*first, std::move(symbol)});
     return;
   }
   symbols_.push_back(std::move(symbol));
-  by_name_.emplace(symbols_.back().name, &symbols_.back());
+  by_name_.Insert(symbols_.back());
 }
 
-const Symbol* SymbolTable::Find(std::string_view name) const {
-  auto it = by_name_.find(name);
-  return it == by_name_.end() ? nullptr : it->second;
+const Symbol* SymbolTable::Find(std::string_view name) const { return by_name_.Find(name); }
+
+const Symbol* SymbolTable::Find(const ir::NamedPoint& point) const {
+  if (point.symbol_table == id_) return point.symbol;
+  point.symbol = by_name_.Find(point.name);
+  point.symbol_table = id_;
+  return point.symbol;
 }
 
 const SymbolTable& SymbolsOf(const ir::Program& program) {
@@ -224,17 +271,15 @@ const Symbol* SymbolTable::PalletFixture(int number) const {
 // ------------------------------------------------------------------ LocalScope
 
 const Symbol* LocalScope::Declare(Symbol local) {
-  auto it = by_name_.find(std::string_view(local.name));
-  if (it != by_name_.end()) return it->second;
+  if (const Symbol* earlier = by_name_.Find(local.name)) return earlier;
   const Symbol* global = globals_.Find(local.name);
   locals_.push_back(std::move(local));
-  by_name_.emplace(locals_.back().name, &locals_.back());
+  by_name_.Insert(locals_.back());
   return global;
 }
 
 const Symbol* LocalScope::Find(std::string_view name) const {
-  auto it = by_name_.find(name);
-  if (it != by_name_.end()) return it->second;
+  if (const Symbol* local = by_name_.Find(name)) return local;
   return globals_.Find(name);
 }
 
@@ -242,7 +287,7 @@ std::vector<std::string> LocalScope::VariableNames() const {
   std::vector<std::string> names;
   for (const Symbol& local : locals_) names.push_back(local.name);
   for (std::string& global : globals_.NamesOf({SymbolKind::Variable})) {
-    if (!by_name_.contains(std::string_view(global))) names.push_back(std::move(global));
+    if (!by_name_.Contains(global)) names.push_back(std::move(global));
   }
   return names;
 }

@@ -53,9 +53,31 @@ struct NameEqual {
 };
 template <typename Value>
 using NameMap = std::unordered_map<std::string, Value, NameHash, NameEqual>;
-// The same keyed by views of names that live elsewhere (a Symbol's name).
-template <typename Value>
-using NameViewMap = std::unordered_map<std::string_view, Value, NameHash, NameEqual>;
+
+// Symbols by name, as the language compares names: an open-addressing table
+// of (hash, symbol) slots, at most half full. A compile looks a name up in
+// every pass, and a CAD-sized program has a million names: a lookup here
+// touches one slot and the symbol it finds, where a node-based map also
+// chases a node and its bucket (cache misses that made the lookups a sixth
+// of a 1 M-placement compile).
+class NameIndex {
+ public:
+  const Symbol* Find(std::string_view name) const;
+  // Adds `symbol` under its own name unless a symbol of that name is there;
+  // returns that one, else null. `symbol` must outlive the index.
+  const Symbol* Insert(const Symbol& symbol);
+  bool Contains(std::string_view name) const { return Find(name) != nullptr; }
+  void Reserve(std::size_t names);
+
+ private:
+  struct Slot {
+    std::size_t hash = 0;
+    const Symbol* symbol = nullptr;  // null: empty
+  };
+  std::size_t SlotOf(std::string_view name, std::size_t hash) const;
+  std::vector<Slot> slots_;  // size: zero or a power of two
+  std::size_t count_ = 0;
+};
 
 // The range of `name` written at `loc` (names are kept as written, so the
 // caret underlines exactly the name).
@@ -93,6 +115,11 @@ class SymbolTable {
   SymbolTable& operator=(const SymbolTable&) = delete;
 
   const Symbol* Find(std::string_view name) const;
+  // The same for a point named in a statement; remembers the answer in
+  // `point` (ir::NamedPoint::symbol), so the next pass asks no hash table.
+  const Symbol* Find(const ir::NamedPoint& point) const;
+  // Distinct for every table built in this process (never 0).
+  std::uint64_t id() const { return id_; }
   // First definitions, in source order.
   const std::deque<Symbol>& symbols() const { return symbols_; }
   const std::vector<Duplicate>& duplicates() const { return duplicates_; }
@@ -124,8 +151,9 @@ class SymbolTable {
   const Symbol* WalkToFixture(const Symbol& frame) const;
   const Symbol* PalletFixture(int number) const;
 
+  std::uint64_t id_ = 0;
   std::deque<Symbol> symbols_;  // deque: Find's pointers stay valid
-  NameViewMap<const Symbol*> by_name_;  // keyed by the symbol's own name
+  NameIndex by_name_;
   std::vector<Duplicate> duplicates_;
   std::map<int, PalletEntry> pallets_;
   std::vector<std::pair<PalletEntry, PalletEntry>> duplicate_pallets_;
@@ -165,7 +193,7 @@ class LocalScope {
  private:
   const SymbolTable& globals_;
   std::deque<Symbol> locals_;
-  NameViewMap<const Symbol*> by_name_;  // keyed by the local's own name
+  NameIndex by_name_;
 };
 
 // The symbols a VarDecl statement declares (one per name).

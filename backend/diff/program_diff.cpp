@@ -371,7 +371,7 @@ class SideModel {
   Placement OfTarget(const ir::PointExpr& target) const {
     Placement p;
     if (const auto* named = std::get_if<ir::NamedPoint>(&target.base)) {
-      const sema::Symbol* symbol = symbols_.Find(named->name);
+      const sema::Symbol* symbol = symbols_.Find(*named);
       SMTCAL_CHECK(symbol != nullptr && symbol->kind == sema::SymbolKind::Point, "checked targets name points");
       p = OfDecl(std::get<ir::PointDecl>(symbol->decl->node));
     } else if (const auto* coords = std::get_if<ir::Coords>(&target.base)) {

@@ -233,6 +233,12 @@ class Emitter {
   // the program's size.
   void ClassifyTargets() {
     for (const Target& target : state_.targets) {
+      // A statement whose point is in a fixture is commanded through it
+      // (CommandOf answers before it asks this map).
+      const ir::PointExpr* point = nullptr;
+      if (const auto* motion = std::get_if<ir::Motion>(&target.stmt->node)) point = &motion->target;
+      if (const auto* pick = std::get_if<ir::PickPlace>(&target.stmt->node)) point = &pick->target;
+      if (point != nullptr && FixtureIndexOf(*point) >= 0) continue;
       bool as_written = target.kind == CorrectionKind::kStatic || target.kind == CorrectionKind::kUncorrected;
       auto [it, inserted] = as_written_.emplace(target.stmt, as_written);
       if (!inserted) it->second = it->second && as_written;
@@ -246,7 +252,7 @@ class Emitter {
   int FixtureIndexOf(const ir::PointExpr& point) {
     const sema::Symbol* fixture = nullptr;
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
-      if (const sema::Symbol* symbol = symbols_.Find(named->name)) fixture = symbols_.FixtureOfPoint(*symbol);
+      if (const sema::Symbol* symbol = symbols_.Find(*named)) fixture = symbols_.FixtureOfPoint(*symbol);
     } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
       if (std::optional<int> number = sema::FoldInteger(pallet->number.get())) {
         fixture = symbols_.FixtureOfPallet(*number);
@@ -714,7 +720,7 @@ class Emitter {
     } else if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
       position.xyzu = PointParams(named->name);
       if (!point.offsets.empty()) {  // the frame is needed for the offsets only
-        const sema::Symbol* symbol = symbols_.Find(named->name);
+        const sema::Symbol* symbol = symbols_.Find(*named);
         SMTCAL_CHECK(symbol != nullptr && symbol->kind == sema::SymbolKind::Point, "a checked target names a point");
         const auto& decl = std::get<ir::PointDecl>(symbol->decl->node);
         if (!decl.taught) frame = decl.frame;

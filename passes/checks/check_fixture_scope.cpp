@@ -244,34 +244,42 @@ class CheckFixtureScope final : public Pass {
     }
   }
 
-  // The fixture a motion target belongs to, and how to name the target.
-  const Symbol* FixtureOf(const ir::PointExpr& point, std::string& what, SourceRange& where) const {
+  // The fixture a motion target belongs to, and where the target is named.
+  const Symbol* FixtureOf(const ir::PointExpr& point, SourceRange& where) const {
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
-      const Symbol* symbol = table_->Find(named->name);
+      const Symbol* symbol = table_->Find(*named);
       if (symbol == nullptr || symbol->kind != SymbolKind::Point) return nullptr;
-      what = fmt::format("point '{}'", symbol->name);
       where = SourceRange(point.loc, named->length);
       return table_->FixtureOfPoint(*symbol);
     }
     if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
       std::optional<int> number = sema::FoldInteger(pallet->number.get());
       if (!number) return nullptr;  // chosen at run time: the runtime checks it
-      what = fmt::format("pallet {}", *number);
       where = SourceRange(point.loc, 6);  // "Pallet"
       return table_->FixtureOfPallet(*number);
     }
     return nullptr;  // XY(...) is in the robot base
   }
 
+  // How a report names the target: "point 'P1'", "pallet 2". Made only for a
+  // report: every placement of a program is a use.
+  std::string Describe(const ir::PointExpr& point) const {
+    if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
+      return fmt::format("point '{}'", table_->Find(*named)->name);
+    }
+    const auto& pallet = std::get<ir::PalletPoint>(point.base);
+    return fmt::format("pallet {}", *sema::FoldInteger(pallet.number.get()));
+  }
+
   void Use(const ir::Stmt& stmt, const ir::PointExpr& target, const ir::Stmt* cycle) {
-    std::string what;
     SourceRange where;
-    const Symbol* fixture = FixtureOf(target, what, where);
+    const Symbol* fixture = FixtureOf(target, where);
     if (fixture == nullptr) return;
     Context context = Effective(cycle);
     if (context.kind == Context::Kind::Unknown) return;
     if (context.kind == Context::Kind::Cycle && sema::SameName(context.fixture, fixture->name)) return;
     if (!FirstReport(stmt)) return;
+    const std::string what = Describe(target);
     if (cycle != nullptr) {
       Diagnostic* diag = diags_->Report(DiagKind::FixturePointOutsideCycle, where, what, fixture->name,
                                         fixture->name, fmt::format("this use is {}", Where(context)));

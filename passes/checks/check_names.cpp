@@ -112,6 +112,7 @@ class CheckNames final : public Pass {
   }
 
   void Definition(const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
+    if (table_->duplicates().empty()) return;
     Symbol mine;
     mine.name = name;
     mine.range = sema::NameAt(name_loc, name);
@@ -121,6 +122,7 @@ class CheckNames final : public Pass {
 
   // Reports `mine` if the table's first definition of the name is another one.
   void Definition(const Symbol& mine) {
+    if (table_->duplicates().empty()) return;  // the usual case: no name is defined twice
     const Symbol* first = table_->Find(mine.name);
     if (first == nullptr || (first->decl == mine.decl && first->range.begin == mine.range.begin)) return;
     Duplicate(mine, *first);
@@ -206,10 +208,15 @@ class CheckNames final : public Pass {
   }
 
   void ScopedUse(const std::string& name, SourceRange where, Want want, std::string_view user) {
+    ScopedUse(name, want != Want::Variable ? table_->Find(name) : nullptr, where, want, user);
+  }
+
+  // `global`: what the global table has for the name (not needed for a variable).
+  void ScopedUse(const std::string& name, const Symbol* global, SourceRange where, Want want,
+                 std::string_view user) {
     if (want != Want::Variable) {
       // Locals are variables; a local that took the name of a global was
       // reported at its declaration, so the global still answers here.
-      const Symbol* global = table_->Find(name);
       Use(global != nullptr && Fits(want, global->kind) ? global : scope_->Find(name), name, where, want, user,
           [&] { return Candidates(want); });
       return;
@@ -296,7 +303,7 @@ class CheckNames final : public Pass {
 
   void Point(const ir::PointExpr& point, std::string_view user) {
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
-      ScopedUse(named->name, SourceRange(point.loc, named->length), Want::Point, user);
+      ScopedUse(named->name, table_->Find(*named), SourceRange(point.loc, named->length), Want::Point, user);
     } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
       Expr(pallet->number.get());
       Expr(pallet->i.get());

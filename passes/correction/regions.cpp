@@ -11,9 +11,9 @@
 // base-frame statement with one known position is static, one with several
 // positions or an unknown one is corrected at run time, and a Jump/Go/Move
 // outside every region is commanded uncorrected (warned). Never changes the IR.
+#include <algorithm>
 #include <memory>
 #include <unordered_map>
-#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -47,12 +47,24 @@ class Regions final : public Pass {
     for (const cell::Region& region : cell.regions) CheckDifficulty(region, diags);
 
     // A base-frame statement is static only when it has one known position.
-    std::unordered_map<const ir::Stmt*, int> positions;
-    std::unordered_set<const ir::Stmt*> any_unknown;
-    positions.reserve(state.targets.size());
+    // Counted only for statements with a base-frame target (a statement can
+    // have fixture targets too: Pallet(n, ...) with n known at run time):
+    // a CAD-sized program's million fixture targets need no map.
+    struct Positions {
+      int count = 0;
+      bool any_unknown = false;
+    };
+    std::unordered_map<const ir::Stmt*, Positions> positions;
+    positions.reserve(static_cast<std::size_t>(
+        std::count_if(state.targets.begin(), state.targets.end(), [](const Target& t) { return t.fixture < 0; })));
     for (const Target& target : state.targets) {
-      ++positions[target.stmt];
-      if (!target.known) any_unknown.insert(target.stmt);
+      if (target.fixture < 0) positions.emplace(target.stmt, Positions{});
+    }
+    for (const Target& target : state.targets) {
+      auto counted = positions.find(target.stmt);
+      if (counted == positions.end()) continue;
+      ++counted->second.count;
+      counted->second.any_unknown = counted->second.any_unknown || !target.known;
     }
     for (Target& target : state.targets) {
       std::string_view keyword = TargetKeyword(*target.stmt);
@@ -60,7 +72,8 @@ class Regions final : public Pass {
       if (target.fixture >= 0) {
         target.kind = CorrectionKind::kFixture;
       } else {
-        bool single = positions[target.stmt] == 1 && !any_unknown.contains(target.stmt);
+        const Positions& at = positions.find(target.stmt)->second;
+        bool single = at.count == 1 && !at.any_unknown;
         target.kind = single ? CorrectionKind::kStatic : CorrectionKind::kRunTimeBase;
       }
       if (!target.known) {

@@ -10,6 +10,7 @@
 // XY(...), the required position kept in the statement's comment, so the
 // corrected program commands the robot directly. Run-time targets keep their
 // text; the controller corrects them.
+#include <charconv>
 #include <memory>
 
 #include <fmt/format.h>
@@ -78,8 +79,18 @@ class StaticInversion final : public Pass {
     point->offsets.clear();
     std::string& comment = stmt.trailing_comment;
     comment += comment.empty() ? " " : "; ";
-    comment += fmt::format("required {} = {}, region {}, residual {:.1e} mm", target.text,
-                           PrintCoords({target.required, {}}), target.region->name, target.residual_mm);
+    // Appended piece by piece: every static placement of a CAD-sized program has one.
+    comment += "required ";
+    comment += target.text;
+    comment += " = ";
+    comment += PrintCoords({target.required, {}});
+    comment += ", region ";
+    comment += target.region->name;
+    comment += ", residual ";
+    char residual[32];  // as printf's %.1e
+    comment.append(residual, std::to_chars(residual, residual + sizeof residual, target.residual_mm,
+                                           std::chars_format::scientific, 1).ptr);
+    comment += " mm";
   }
 };
 

@@ -62,6 +62,12 @@ class Tracer {
   Tracer(const sema::SymbolTable& symbols, CompileState& state, Diagnostics& diags)
       : symbols_(symbols), state_(state), diags_(diags) {}
 
+  // Room for `statements` motion statements (so the map of them is not rehashed as it grows).
+  void Reserve(std::size_t statements) {
+    first_of_stmt_.reserve(statements);
+    next_of_stmt_.reserve(statements);
+  }
+
   void Run() {
     for (const sema::Symbol& symbol : symbols_.symbols()) {
       if (symbol.kind == sema::SymbolKind::Variable) globals_[sema::Lowercase(symbol.name)] = 0.0;
@@ -172,7 +178,7 @@ class Tracer {
     std::string frame_name;
     Pose4 local{};
     if (const auto* named = std::get_if<ir::NamedPoint>(&target.base)) {
-      const sema::Symbol* point = symbols_.Find(named->name);
+      const sema::Symbol* point = symbols_.Find(*named);
       SMTCAL_CHECK(point != nullptr && point->kind == sema::SymbolKind::Point,
                    "a checked program names only points as targets");
       const auto& decl = std::get<ir::PointDecl>(point->decl->node);
@@ -326,7 +332,7 @@ class Tracer {
   std::string FrameRootOf(const ir::PointExpr& point, Frame& frame) {
     std::string frame_name;
     if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
-      const sema::Symbol* symbol = symbols_.Find(named->name);
+      const sema::Symbol* symbol = symbols_.Find(*named);
       const auto& decl = std::get<ir::PointDecl>(symbol->decl->node);
       if (decl.taught) return decl.frame;
       frame_name = decl.frame;
@@ -559,7 +565,9 @@ void TraceTargets(const ir::Program& program, const sema::SymbolTable& symbols, 
     motions += std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node);
   });
   state.targets.reserve(state.targets.size() + motions);
-  Tracer(symbols, state, diags).Run();
+  Tracer tracer(symbols, state, diags);
+  tracer.Reserve(motions);
+  tracer.Run();
 }
 
 }  // namespace smtcal

@@ -3,6 +3,12 @@
 // across Calls, reachability). The golden suite tests/golden/check/ runs the
 // same checks on parsed files and shows the exact messages.
 #include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstdlib>
+#include <deque>
+#include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -70,6 +76,66 @@ TEST(SymbolTable, OneCaseInsensitiveNamespaceWhereTheFirstDefinitionWins) {
   EXPECT_EQ(table.Find("Count")->var_type, VarType::Integer);
   EXPECT_EQ(table.NamesOf({sema::SymbolKind::Fixture, sema::SymbolKind::Variable}),
             (std::vector<std::string>{"Board", "count"}));
+}
+
+// NameIndex against a plain map of lowercased names, on random names that
+// differ in case, share prefixes and collide in the table's low bits (seed
+// printed; SMTCAL_TEST_SEED repeats a run).
+TEST(SymbolTable, NameIndexAgreesWithAMapOfLowercaseNames) {
+  const char* seed_text = std::getenv("SMTCAL_TEST_SEED");
+  const std::uint64_t seed = seed_text != nullptr ? std::strtoull(seed_text, nullptr, 10) : 19940101;
+  SCOPED_TRACE(::testing::Message() << "SMTCAL_TEST_SEED=" << seed);
+  std::mt19937_64 rng(seed);
+  const std::string letters = "aAbBcCpP_0123456789";
+  std::deque<sema::Symbol> symbols;
+  sema::NameIndex index;
+  std::map<std::string, const sema::Symbol*> reference;
+  for (int i = 0; i < 20000; ++i) {
+    std::string name(1, "PpCcRr"[rng() % 6]);
+    for (std::size_t n = rng() % 6; n > 0; --n) name += letters[rng() % letters.size()];
+    sema::Symbol& symbol = symbols.emplace_back();
+    symbol.name = name;
+    auto [it, added] = reference.emplace(sema::Lowercase(name), &symbol);
+    EXPECT_EQ(index.Insert(symbol), added ? nullptr : it->second) << name;
+    // Every lookup so far, in another case, finds the first definition.
+    if (i % 97 == 0) {
+      for (const auto& [lower, first] : reference) {
+        std::string upper = lower;
+        for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        ASSERT_EQ(index.Find(upper), first) << upper;
+      }
+    }
+  }
+  EXPECT_EQ(index.Find("Q"), nullptr);
+  EXPECT_EQ(index.Find(""), nullptr);
+  EXPECT_EQ(sema::NameIndex().Find("P1"), nullptr);
+}
+
+// A point named in a statement remembers what its name was found as, for
+// the table that found it only: another table (built after a pass changed
+// the declarations) looks the name up again.
+TEST(SymbolTable, NamedPointsRememberTheirSymbolPerTable) {
+  IrBuilder b;
+  b.Fixture("Board");
+  b.Point("C1", {0, 0, 0, 0}, "Board");
+  ir::Program& program = b.Finish();
+  ir::NamedPoint use{"c1", 2};
+  sema::SymbolTable first = sema::SymbolTable::Build(program);
+  const sema::Symbol* found = first.Find(use);
+  ASSERT_NE(found, nullptr);
+  EXPECT_EQ(found, first.Find("C1"));
+  EXPECT_EQ(use.symbol, found);
+  EXPECT_EQ(use.symbol_table, first.id());
+  EXPECT_EQ(first.Find(use), found);
+
+  sema::SymbolTable second = sema::SymbolTable::Build(program);
+  EXPECT_NE(second.id(), first.id());
+  EXPECT_EQ(second.Find(use), second.Find("C1"));
+  EXPECT_NE(second.Find(use), found);  // the second table's own symbol
+  ir::NamedPoint missing{"C2", 2};
+  EXPECT_EQ(second.Find(missing), nullptr);
+  EXPECT_EQ(missing.symbol_table, second.id());
+  EXPECT_EQ(second.Find(missing), nullptr);
 }
 
 TEST(SymbolTable, DeclarationsRangeUnderlinesTheName) {
