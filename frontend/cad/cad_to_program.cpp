@@ -688,7 +688,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       const SourceLoc loc = part.designator_range.begin;
       const std::string wanted = panel ? boards[b] + "_" + MakeIdentifier(part.designator) : MakeIdentifier(part.designator);
       std::optional<NameOwner> taken;
-      const std::string name = names.Claim(wanted, {"the point of", part.designator, part.line}, &taken);
+      std::string name = names.Claim(wanted, {"the point of", part.designator, part.line}, &taken);
       // Equal designators make equal names, so a duplicate shows as a
       // collision with the point of the same designator.
       if (b == 0 && taken) {
@@ -705,7 +705,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       double theta = part.rotation_deg;
       if (mirror_rotation) theta = mirror == ImportMirror::kX ? 180.0 - theta : -theta;
       double u = NormaliseAngle(theta + part.feeder->rotation_offset_deg, options_.angles);
-      ir::PointDecl point{name, loc, false,
+      ir::PointDecl point{std::move(name), loc, false,
                           MakeCoords(loc, {x, y, options_.place_z_mm, u}), boards[b], loc};
       items.push_back(MakeStmt(loc, std::move(point), comments[i]));
     }
