@@ -271,14 +271,16 @@ StagedOutput::~StagedOutput() {
   if (!temporary_.empty()) ::unlink(temporary_.c_str());
 }
 
-Status StagedOutput::Commit() {
-  if (path_ == "-") {
-    std::fwrite(stdout_text_.data(), 1, stdout_text_.size(), stdout);
-    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-      return Error{fmt::format("cannot write to standard output: {}", Errno(errno))};
-    }
-    return Ok{};
+Status WriteToStdout(std::string_view text) {
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    return Error{fmt::format("cannot write to standard output: {}", Errno(errno))};
   }
+  return Ok{};
+}
+
+Status StagedOutput::Commit() {
+  if (path_ == "-") return WriteToStdout(stdout_text_);
   SMTCAL_CHECK(!temporary_.empty(), "a staged output is committed once");
   Status closed = Close();
   if (!closed) return closed.error();

@@ -93,6 +93,10 @@ class StagedOutput {
   int write_error_ = 0;      // the errno of the first failed write
 };
 
+// `text` on standard output, flushed: the "-" output of StagedOutput and
+// TextOutput.
+Status WriteToStdout(std::string_view text);
+
 // Stage and Commit in one: a failure never leaves a half-written output.
 Status WriteFileAtomically(const std::string& path, std::string_view contents);
 

@@ -1,11 +1,6 @@
 #include "base/text_output.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <utility>
-
-#include <fmt/core.h>
 
 namespace smtcal {
 
@@ -31,11 +26,7 @@ void TextOutput::Flush() {
 
 Status TextOutput::Commit() {
   if (path_.empty()) return Ok{};
-  if (path_ == "-") {
-    std::fwrite(buffer_.data(), 1, buffer_.size(), stdout);
-    if (std::fflush(stdout) != 0 || std::ferror(stdout)) return Error{fmt::format("cannot write to standard output: {}", std::strerror(errno))};
-    return Ok{};
-  }
+  if (path_ == "-") return WriteToStdout(buffer_);
   Flush();
   Status committed = file_->Commit();
   file_.reset();

@@ -143,11 +143,12 @@ std::vector<int> TripRegions(const cell::Fixture& fixture, const std::vector<cel
   return result;
 }
 
-FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture& fixture)
+FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture& fixture,
+                                     std::vector<Eigen::Vector2d> region_table_se)
     : cell_(cell),
       sensor_accuracy_mm_(fixture.sensor_accuracy_mm),
       latency_mm_(fixture.scan_speed_mm_s * cell.robot.servo_period_s),
-      region_table_se_(RegionTableNoise(cell)) {
+      region_table_se_(region_table_se.empty() ? RegionTableNoise(cell) : std::move(region_table_se)) {
   trip_regions_ = TripRegions(fixture, cell.regions);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const Eigen::Affine3d nominal = NominalFix(fixture);

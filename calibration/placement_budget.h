@@ -113,7 +113,10 @@ std::vector<int> TripRegions(const cell::Fixture& fixture, const std::vector<cel
 // estimator at the nominal pose) and what each trip's error is made of.
 class FixtureErrorModel {
  public:
-  FixtureErrorModel(const cell::Cell& cell, const cell::Fixture& fixture);
+  // `region_table_se`: the cell's RegionTableNoise when the caller has it
+  // (a compile finds it once for all its budgets); found here when empty.
+  FixtureErrorModel(const cell::Cell& cell, const cell::Fixture& fixture,
+                    std::vector<Eigen::Vector2d> region_table_se = {});
 
   // False when the fixture's nominal trips define no pose (then every budget
   // is unbounded).

@@ -68,8 +68,13 @@ TeachPose EstimateTeachPose(const cell::Fixture& fixture, const cell::Cell& cell
 
 const FixtureErrorModel& CompileState::ErrorModelFor(const cell::Fixture& fixture) const {
   std::unique_ptr<FixtureErrorModel>& model = error_models_[&fixture];
-  if (!model) model = std::make_unique<FixtureErrorModel>(*cell, fixture);
+  if (!model) model = std::make_unique<FixtureErrorModel>(*cell, fixture, RegionTableNoiseOnce());
   return *model;
+}
+
+const std::vector<Eigen::Vector2d>& CompileState::RegionTableNoiseOnce() const {
+  if (region_table_se_.empty()) region_table_se_ = RegionTableNoise(*cell);
+  return region_table_se_;
 }
 
 ErrorBudget CompileState::BudgetOf(const Target& target) const {
@@ -78,9 +83,8 @@ ErrorBudget CompileState::BudgetOf(const Target& target) const {
                                                                      target.residual_mm);
   }
   if (target.region == nullptr) return StaticBudget(*cell, nullptr, target.residual_mm);
-  if (region_table_se_.empty()) region_table_se_ = RegionTableNoise(*cell);
   return StaticBudget(*cell, target.region, target.residual_mm,
-                      region_table_se_[static_cast<std::size_t>(target.region - cell->regions.data())]);
+                      RegionTableNoiseOnce()[static_cast<std::size_t>(target.region - cell->regions.data())]);
 }
 
 std::string_view TargetKeyword(const ir::Stmt& stmt) {

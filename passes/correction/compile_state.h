@@ -166,7 +166,10 @@ struct CompileState {
   std::unordered_map<std::string_view, const std::string*> shared_by_text_;
   // A cache: the models depend only on the cell.
   mutable std::map<const cell::Fixture*, std::unique_ptr<FixtureErrorModel>> error_models_;
-  mutable std::vector<Eigen::Vector2d> region_table_se_;  // RegionTableNoise, on first use
+  // The cell's RegionTableNoise, found on first use and shared by the
+  // static budgets and the fixtures' error models.
+  const std::vector<Eigen::Vector2d>& RegionTableNoiseOnce() const;
+  mutable std::vector<Eigen::Vector2d> region_table_se_;
 };
 
 // The base-frame position of a fixture-frame pose through FIX.
