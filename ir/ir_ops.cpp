@@ -1,5 +1,7 @@
 #include "ir/ir_ops.h"
 
+#include <utility>
+
 #include "base/check.h"
 
 namespace smtcal::ir {
@@ -95,6 +97,14 @@ Precedence BinaryOpPrecedence(BinaryOp op) {
   SMTCAL_CHECK(false, "unknown binary operator");
   return kPrimaryPrecedence;
 }
+
+const PointExpr* MotionTarget(const Stmt& stmt) {
+  if (const auto* pick = std::get_if<PickPlace>(&stmt.node)) return &pick->target;
+  if (const auto* motion = std::get_if<Motion>(&stmt.node)) return &motion->target;
+  return nullptr;
+}
+
+PointExpr* MotionTarget(Stmt& stmt) { return const_cast<PointExpr*>(MotionTarget(std::as_const(stmt))); }
 
 const Stmt* CorrectedHeader(const Program& program) {
   for (const StmtPtr& stmt : program.items) {

@@ -23,6 +23,11 @@ std::string_view MotionSpelling(MotionKind kind);
 // "Pick", "Place".
 std::string_view PickPlaceSpelling(PickPlaceKind kind);
 
+// The point a Jump/Go/Move or a Pick/Place commands; null for any other
+// statement.
+const PointExpr* MotionTarget(const Stmt& stmt);
+PointExpr* MotionTarget(Stmt& stmt);
+
 // `smtcal compile --target place` output opens with comments, the first of
 // them starting with this: what the program is, so it is never compiled twice.
 inline constexpr std::string_view kCorrectedHeaderPrefix = " Corrected by smtcal ";

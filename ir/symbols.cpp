@@ -77,12 +77,8 @@ void NameIndex::Reserve(std::size_t names) {
   while (size < names * 2) size *= 2;
   if (size <= slots_.size()) return;
   std::vector<Slot> old = std::exchange(slots_, std::vector<Slot>(size));
-  const std::size_t mask = size - 1;
   for (const Slot& slot : old) {
-    if (slot.symbol == nullptr) continue;
-    std::size_t i = slot.hash & mask;
-    while (slots_[i].symbol != nullptr) i = (i + 1) & mask;
-    slots_[i] = slot;
+    if (slot.symbol != nullptr) slots_[SlotOf(slot.symbol->name, slot.hash)] = slot;
   }
 }
 

@@ -905,9 +905,7 @@ class Differ {
   // coordinates". Lines without a target compare whole.
   static std::string StripCoordinates(const Item& item) {
     if (!item.placement) return Lowercase(item.text);
-    const ir::PointExpr* target = nullptr;
-    if (const auto* motion = std::get_if<ir::Motion>(&item.stmt->node)) target = &motion->target;
-    if (const auto* pick = std::get_if<ir::PickPlace>(&item.stmt->node)) target = &pick->target;
+    const ir::PointExpr* target = ir::MotionTarget(*item.stmt);
     std::string text = Lowercase(item.text);
     if (target == nullptr) {  // a declaration: everything but its coordinates
       std::size_t open = text.find("xy(");

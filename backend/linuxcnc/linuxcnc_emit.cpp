@@ -36,6 +36,7 @@
 #include "backend/linuxcnc/linuxcnc_dry_run.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "ir/constant_fold.h"
+#include "ir/ir_ops.h"
 #include "ir/ir_text.h"
 #include "ir/ir_walk.h"
 #include "ir/symbols.h"
@@ -235,9 +236,7 @@ class Emitter {
     for (const Target& target : state_.targets) {
       // A statement whose point is in a fixture is commanded through it
       // (CommandOf answers before it asks this map).
-      const ir::PointExpr* point = nullptr;
-      if (const auto* motion = std::get_if<ir::Motion>(&target.stmt->node)) point = &motion->target;
-      if (const auto* pick = std::get_if<ir::PickPlace>(&target.stmt->node)) point = &pick->target;
+      const ir::PointExpr* point = ir::MotionTarget(*target.stmt);
       if (point != nullptr && FixtureIndexOf(*point) >= 0) continue;
       bool as_written = target.kind == CorrectionKind::kStatic || target.kind == CorrectionKind::kUncorrected;
       auto [it, inserted] = as_written_.emplace(target.stmt, as_written);

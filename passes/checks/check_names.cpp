@@ -112,7 +112,6 @@ class CheckNames final : public Pass {
   }
 
   void Definition(const ir::Stmt& stmt, const std::string& name, SourceLoc name_loc) {
-    if (table_->duplicates().empty()) return;
     Symbol mine;
     mine.name = name;
     mine.range = sema::NameAt(name_loc, name);

@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "ir/ir_ops.h"
 #include "ir/ir_text.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
@@ -23,12 +24,6 @@
 namespace smtcal {
 
 namespace {
-
-ir::PointExpr* TargetOf(ir::Stmt& stmt) {
-  if (auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) return &pick->target;
-  if (auto* motion = std::get_if<ir::Motion>(&stmt.node)) return &motion->target;
-  return nullptr;
-}
 
 class StaticInversion final : public Pass {
  public:
@@ -70,7 +65,7 @@ class StaticInversion final : public Pass {
   // The statement now commands the nominal position itself.
   static void Lower(const Target& target) {
     auto& stmt = const_cast<ir::Stmt&>(*target.stmt);  // the pass owns the IR it runs on
-    ir::PointExpr* point = TargetOf(stmt);
+    ir::PointExpr* point = ir::MotionTarget(stmt);
     SMTCAL_CHECK(point != nullptr, "a target is a Motion or a Pick/Place");
     ir::Coords coords;
     coords.values = target.nominal;
