@@ -207,6 +207,12 @@ struct Feeder {
   SourceRange range;  // the [[feeder]] table
 };
 
+// The cycle record's bound per file ([linuxcnc] record_max_cycles): a week
+// of the paper cell's cycles; at most what `smtcal monitor` reads in one
+// file (256 MiB) for a fixture of 32 trips.
+inline constexpr int kDefaultRecordMaxCycles = 10000;
+inline constexpr int kMaxRecordMaxCycles = 100000;
+
 // [linuxcnc]: how the cell's LinuxCNC controller is wired, for
 // `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that
 // target needs it (and reports its absence).
@@ -214,6 +220,14 @@ struct LinuxCnc {
   char rotation_axis = 'C';      // the axis word u is commanded on: A, B or C
   int vacuum_sensor_input = 0;   // motion.digital-in-NN the gripper's vacuum sensor is wired to
   double vacuum_timeout_s = 0;   // how long a Pick/Place waits for the sensor before aborting (> 0)
+  // The cycle record (docs/monitor.md): the log file the runtime appends a
+  // record of every scan to (empty: none), how many scans a file holds
+  // before the runtime goes on in the other of its two files, and the HAL
+  // pin it reads the time from (empty: no clock).
+  std::string record_file;
+  int record_max_cycles = kDefaultRecordMaxCycles;
+  std::string record_clock_pin;
+  SourceRange record_file_range;  // the key, for messages
   SourceRange range;             // the [linuxcnc] table
 };
 

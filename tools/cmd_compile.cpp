@@ -57,13 +57,6 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
                        std::make_move_iterator(header.end()));
 }
 
-std::string ProgramName(const ir::Program& program) {
-  for (const ir::StmtPtr& item : program.items) {
-    if (const auto* decl = std::get_if<ir::ProgramDecl>(&item->node)) return decl->name;
-  }
-  return "program";
-}
-
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
       OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
@@ -110,7 +103,7 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
       options.exit_code = kExitInputError;
       return;
     }
-    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ProgramName(compiled.program));
+    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ir::ProgramName(compiled.program));
   } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
   }

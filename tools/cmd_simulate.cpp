@@ -12,7 +12,9 @@
 
 #include "base/json_text.h"
 #include "backend/reports/compile_report.h"
+#include "backend/c/record_text.h"
 #include "backend/reports/simulate_report.h"
+#include "base/text_output.h"
 #include "calibration/cell.h"
 #include "frontend/parse.h"
 #include "frontend/truth_toml.h"
@@ -21,6 +23,7 @@
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
 #include "simulation/virtual_cell.h"
+#include "ir/ir_ops.h"
 #include "tools/commands.h"
 #include "tools/compile_pipeline.h"
 
@@ -32,9 +35,30 @@ struct SimulateOptions {
   std::string cell_path;
   std::string truth_path;
   std::string svg;
+  std::string record;
   bool json = false;
   SimOptions sim;
 };
+
+// The decimals of a simulated record: the LinuxCNC runtime's (%.6f), so a
+// simulated log reads like a controller's.
+constexpr int kRecordDecimals = 6;
+
+// The improved mode's scans as the controller would log them (docs/monitor.md).
+Status WriteRecord(const std::string& path, const SimResult& result, const cell::Cell& cell,
+                   const std::string& program) {
+  Result<std::unique_ptr<TextOutput>> opened = TextOutput::Open(path);
+  if (!opened) return opened.error();
+  TextOutput& out = *opened.value();
+  RecordBegin begin;
+  begin.cell = cell.name;
+  begin.program = program;
+  for (const cell::Fixture& fixture : cell.fixtures) begin.fixtures.push_back({fixture.name, ExpectedTrips(fixture).size()});
+  begin.clock = "simulate";
+  out.Append(RecordBeginText(begin));
+  for (const CycleRecord& record : result.records) out.Append(CycleRecordText(record, kRecordDecimals));
+  return out.Commit();
+}
 
 // Placements the compile-time trace could not place (warned), and whether
 // any Cycle places anything at all.
@@ -89,7 +113,8 @@ bool FitsInMemory(const CompileState& state, const SimOptions& sim, GlobalOption
 }
 
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("--svg", opt.svg, {opt.program_path, opt.cell_path, opt.truth_path})) {
+  if (OutputOverwritesInput("--svg", opt.svg, {opt.program_path, opt.cell_path, opt.truth_path}) ||
+      OutputOverwritesInput("--record", opt.record, {opt.program_path, opt.cell_path, opt.truth_path, opt.svg})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -121,10 +146,18 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   if (diags.has_errors()) return;
 
   if (!FitsInMemory(state, opt.sim, options)) return;
-  SimResult result = Simulate(state, truth, opt.sim);
+  SimOptions sim = opt.sim;
+  sim.record = !opt.record.empty();
+  SimResult result = Simulate(state, truth, sim);
   SimulateContext context{opt.program_path, &*compiled.cell, &truth, over_budget};
   if (!opt.svg.empty()) {
     if (Status written = WriteFileAtomically(opt.svg, SimulateReportSvg(result, context)); !written) {
+      options.exit_code = ReportIoError(written.error());
+      return;
+    }
+  }
+  if (!opt.record.empty()) {
+    if (Status written = WriteRecord(opt.record, result, *compiled.cell, ir::ProgramName(compiled.program)); !written) {
       options.exit_code = ReportIoError(written.error());
       return;
     }
@@ -135,6 +168,10 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
     return;
   }
   if (!opt.svg.empty()) SayDone(options, opt.svg, fmt::format("wrote the picture {}", opt.svg));
+  if (!opt.record.empty()) {
+    SayDone(options, opt.record,
+            fmt::format("wrote {} cycle records to {} (read them with smtcal monitor)", result.records.size(), opt.record));
+  }
 }
 
 }  // namespace
@@ -158,6 +195,9 @@ void AddSimulateCommand(CLI::App& app, GlobalOptions& options) {
       ->capture_default_str();
   simulate->add_flag("--json", opt.json, "print the report as JSON");
   simulate->add_option("--svg", opt.svg, "also write a picture: error scatter per mode and histograms");
+  simulate->add_option("--record", opt.record,
+                       "also write the record of every scan of the improved mode, as the controller's runtime logs "
+                       "it (docs/monitor.md; read it with smtcal monitor)");
   simulate->add_option("--missed-trip-rate", opt.sim.missed_trip_rate,
                        "fault injection: probability per cycle that the sensor misses one trip")
       ->check(CLI::Range(0.0, 1.0));

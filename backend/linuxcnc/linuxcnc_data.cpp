@@ -205,6 +205,7 @@ void AppendFixture(Layout& layout, const cell::Fixture& fixture, int directory_e
   layout.Set(at + L::kFxScanFeed, fixture.scan_speed_mm_s * 60, n + ": scan feed mm/min");
   layout.Set(at + L::kFxHasFix, 0, n + ": not scanned yet");
   layout.Set(at + L::kFxStatus, 0, n + ": last scan status");
+  layout.Set(at + L::kFxRecordCycles, 0, n + ": scans recorded since the start");
 
   const int edges_at = layout.Reserve(trips);
   layout.Set(at + L::kFxTripEdgeAt, edges_at, n + ": trip edges at");
@@ -290,6 +291,7 @@ std::string EmitLinuxCncData(const cell::Cell& cell) {
   out += fmt::format("#{} = 0  ; a failed check aborts\n", L::kReportOnly);
   out += layout.Text();
   out += fmt::format("#{} = {}  ; loaded: layout version\n", L::kVersion, L::kLayoutVersion);
+  out += "o<smtcal_record_open> call  ; the cycle record: its begin line (smtcal_record_open.ngc)\n";
   out += "o<smtcal_data> endsub\n";
   return out;
 }

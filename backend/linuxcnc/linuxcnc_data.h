@@ -39,7 +39,15 @@ inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 
                      kFxTripNominalAt = 29, kFxTripsAt = 30, kFxTrippedAt = 31, kFxCalibratedAt = 32,
                      kFxScanPathsAt = 33, kFxHasFix = 34, kFxFix = 35, kFxStatus = 41, kFxFailedTrip = 42,
                      kFxCheckValue = 43 /* + code 1..11 */, kFxCheckEvaluated = 55 /* + code */, kFxS = 67,
-                     kFxScale = 73, kFxRecordSize = 80;
+                     kFxScale = 73, kFxRecordCycles = 74, kFxRecordSize = 80;
+// The cycle record (backend/linuxcnc/linuxcnc_record.h): the line buffer the
+// LOG comments print, above the estimators' scratch; and the counters that
+// bound the log files, kept across runs in the machine's parameter file.
+inline constexpr int kRecordBuffer = 4969;   // #4969..#4993: fixture, cycle, status, trip, time, S1..S3, checks, trip
+inline constexpr int kRecordSegment = 4996;  // the log's segment: one more at every change of file
+inline constexpr int kRecordFile = 4997;     // 0: record_file, 1: record_file.1
+inline constexpr int kRecordCount = 4998;    // scans recorded in that file
+inline constexpr int kRecordKept = 4999;     // 1 when the parameter file keeps #4996..#4999
 // Region record offsets.
 inline constexpr int kRgXLo = 0, kRgXHi = 1, kRgYLo = 2, kRgYHi = 3, kRgDomain = 4, kRgContraction = 8,
                      kRgIterationBound = 9, kRgOutside = 10, kRgDxAt = 11, kRgDyAt = 12, kRgRecordSize = 13;

@@ -6,7 +6,9 @@
 // and prints FIX, every check's value, the verdict and the corrected
 // targets through (DEBUG, ...) with scaled values; a bad scan aborts before
 // the first placement; the example cell's data loads; a replacement
-// smtcal_probe_trips.ngc earlier on the subroutine path supplies trips.
+// smtcal_probe_trips.ngc earlier on the subroutine path supplies trips. The
+// cycle record every scan leaves (LOG lines, docs/monitor.md) is read back
+// with smtcal's reader and equals the C++ scan to its 6 decimals.
 #include <unistd.h>
 
 #include <cmath>
@@ -25,11 +27,14 @@
 
 #include "backend/linuxcnc/embedded_files.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/diagnostics.h"
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/cycle_record.h"
 #include "frontend/cell_toml.h"
+#include "frontend/record_log.h"
 #include "tests/unit/backend/rs274_runner.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
@@ -69,6 +74,8 @@ struct Workspace {
     }
     std::ofstream(sub / "smtcal_data.ngc", std::ios::binary) << EmitLinuxCncData(cell);
     std::ofstream(sub / "smtcal_scan_abort.ngc", std::ios::binary) << EmitLinuxCncScanAbort(cell);
+    std::ofstream(sub / "smtcal_record.ngc", std::ios::binary) << EmitLinuxCncRecord(cell, "test");
+    std::ofstream(sub / "smtcal_record_open.ngc", std::ios::binary) << EmitLinuxCncRecordOpen(cell, "test");
     std::vector<fs::path> path;
     if (with_override_dir) {
       fs::create_directories(dir / "first");
@@ -366,7 +373,19 @@ cell::Cell HarnessCell(std::mt19937_64& rng, cell::Estimator estimator) {
   decoy.origin_mm = fixture.origin_mm + Eigen::Vector2d(300, 0);
   cell.fixtures.push_back(decoy);
   cell.fixtures.push_back(fixture);
+  cell::LinuxCnc linuxcnc;
+  linuxcnc.record_file = "harness.log";  // rs274 prints the LOG lines instead
+  cell.linuxcnc = linuxcnc;
   return cell;
+}
+
+// The cycle records among rs274's canonical commands: LOG("line").
+std::string LoggedText(const test::Rs274Result& run) {
+  std::string text;
+  for (const std::string& line : run.canon) {
+    if (line.starts_with("LOG(\"") && line.ends_with("\")")) text += line.substr(5, line.size() - 7) + "\n";
+  }
+  return text;
 }
 
 // The harness's fixture in HarnessCell.
@@ -491,10 +510,47 @@ void RunHarness(std::mt19937_64& rng, cell::Estimator estimator, int cases, int 
   const test::Rs274Result run = ws.Run(program);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const Printed printed = ParseMessages(run.messages);
+  // Every scan's record, refused or not, read back as smtcal monitor reads it.
+  SourceManager sources;
+  Diagnostics diags(sources);
+  RecordLog log;
+  const std::string logged = LoggedText(run);
+  ASSERT_TRUE(ReadRecordLog(sources.Add("harness.log", logged), log, diags)) << diags.RenderText() << logged;
+  ASSERT_EQ(diags.warning_count(), 0u) << diags.RenderText();
+  ASSERT_EQ(log.begins.size(), 1u);
+  EXPECT_EQ(log.begins[0].begin.fixtures.size(), 2u);
+  ASSERT_EQ(log.cycles.size(), static_cast<std::size_t>(cases)) << logged;
 
   for (int i = 0; i < cases; ++i) {
     SCOPED_TRACE(fmt::format("case {} (fault {})", i, (first_fault + i) % kFaultCount));
     const ScanResult& cpp = expected[static_cast<std::size_t>(i)].scan;
+    {
+      // The record: what C++ makes of the same trips, to the 6 decimals LinuxCNC writes.
+      const CycleRecord want = RecordOfScan(kHarnessFixture, i + 1, std::nullopt, cpp);
+      const CycleRecord& got = log.cycles[static_cast<std::size_t>(i)].record;
+      EXPECT_EQ(got.fixture, want.fixture);
+      EXPECT_EQ(got.cycle, want.cycle);
+      EXPECT_EQ(got.status, want.status);
+      EXPECT_EQ(got.trip, want.trip);
+      EXPECT_FALSE(got.time_s);
+      ASSERT_EQ(got.trips.size(), want.trips.size());
+      for (std::size_t k = 0; k < want.trips.size(); ++k) {
+        ASSERT_EQ(got.trips[k].has_value(), want.trips[k].has_value()) << "T" << k + 1;
+        if (want.trips[k]) {
+          EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), 5.000001e-7);
+        }
+      }
+      for (std::size_t c = 0; c < want.checks.size(); ++c) {
+        ASSERT_EQ(got.checks[c].has_value(), want.checks[c].has_value()) << "check " << c + 1;
+        if (want.checks[c]) {
+          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), 5.000001e-7) << "check " << c + 1;
+        }
+      }
+      ASSERT_EQ(got.estimate.has_value(), want.estimate.has_value());
+      for (std::size_t k = 0; k < 3 && want.estimate; ++k) {
+        EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), 5.000001e-7);
+      }
+    }
     ASSERT_EQ(printed.scans.count(i), 1u) << run.out;
     const Printed::Scan& s = printed.scans.at(i);
     const CheckResult* failure = cpp.FirstFailure();
