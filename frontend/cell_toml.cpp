@@ -28,6 +28,7 @@
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
 #include "calibration/placement_budget.h"
+#include "calibration/scan_plan.h"
 #include "calibration/tolerances.h"
 #include "frontend/input_kind.h"
 #include "frontend/table_csv.h"
@@ -280,8 +281,9 @@ std::optional<double> PositiveNumber(Keys& keys, std::string_view key, std::stri
   return value->value;
 }
 
-std::optional<double> NonNegativeNumber(Keys& keys, std::string_view key, std::string_view unit) {
-  std::optional<Located<double>> value = Number(keys, key, Need::kRequired, unit);
+std::optional<double> NonNegativeNumber(Keys& keys, std::string_view key, std::string_view unit,
+                                        Need need = Need::kRequired) {
+  std::optional<Located<double>> value = Number(keys, key, need, unit);
   if (!value) return std::nullopt;
   if (value->value < 0) {
     ReportOutOfRange(keys, key, *value, fmt::format("0 {} or more", unit));
@@ -521,6 +523,9 @@ void Loader::ReadRobot(const toml::table& table, Robot& robot) {
   }
   robot.servo_period_range = keys.KeyRange("servo_period_s");
   if (auto period = PositiveNumber(keys, "servo_period_s", "s", Need::kOptional)) robot.servo_period_s = *period;
+  if (auto turnaround = NonNegativeNumber(keys, "probe_turnaround_s", "s", Need::kOptional)) {
+    robot.probe_turnaround_s = *turnaround;
+  }
   keys.Finish();
   robot_ = robot;
   robot_ok_ = diags_.error_count() == errors_before;
@@ -916,6 +921,19 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
     fixture.place_z_range = keys.KeyRange("place_z_mm");
   }
   fixture.scan_speed_mm_s = PositiveNumber(keys, "scan_speed_mm_s", "mm/s").value_or(0);
+  fixture.latch_speed_range = keys.KeyRange("latch_speed_mm_s");
+  if (std::optional<Located<double>> latch = Number(keys, "latch_speed_mm_s", Need::kOptional, "mm/s")) {
+    if (latch->value <= 0) {
+      ReportOutOfRange(keys, "latch_speed_mm_s", *latch, "greater than 0 mm/s");
+    } else if (fixture.scan_speed_mm_s > 0 && latch->value > fixture.scan_speed_mm_s) {
+      ReportOutOfRange(keys, "latch_speed_mm_s", *latch,
+                       fmt::format("at most scan_speed_mm_s = {} mm/s: the search finds each edge at the scan "
+                                   "speed, the latch measures it again slower",
+                                   Num(fixture.scan_speed_mm_s)));
+    } else {
+      fixture.latch_speed_mm_s = latch->value;
+    }
+  }
   std::optional<double> window = PositiveNumber(keys, "trip_window_mm", "mm");
   fixture.trip_window_mm = window.value_or(0);
   fixture.sensor_input = IntegerIn(keys, "sensor_input", limits::kIoBitMin, limits::kIoBitMax,
@@ -1172,11 +1190,21 @@ static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostic
                   fmt::format("{:.3f}", windows[k].nominal.x()), fmt::format("{:.3f}", windows[k].nominal.y()),
                   Num(fixture.trip_window_mm), accuracy);
   }
-  const double late_mm = fixture.scan_speed_mm_s * cell.robot.servo_period_s;
+  const double late_mm = fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s;
   if (late_mm > 0.25 * fixture.max_line_residual_mm) {
-    diags.Report(DiagKind::CellTripLatency, fixture.scan_speed_range, Printable(fixture.name),
-                  Num(fixture.scan_speed_mm_s), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
-                  Num(fixture.max_line_residual_mm));
+    const bool two_stage = fixture.latch_speed_mm_s > 0;
+    diags.Report(DiagKind::CellTripLatency, two_stage ? fixture.latch_speed_range : fixture.scan_speed_range,
+                  Printable(fixture.name), two_stage ? "latches its trips" : "scans",
+                  Num(fixture.TripLatchSpeedMmS()), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
+                  Num(fixture.max_line_residual_mm), two_stage ? "latch_speed_mm_s" : "scan_speed_mm_s");
+  }
+  const CaptureRange capture = ScanCaptureRange(fixture);
+  if (capture.factor < 1) {
+    const ScanPath& first = fixture.scan_paths.front();
+    diags.Report(DiagKind::CellScanCaptureRange, first.range, Printable(fixture.name),
+                  fmt::format("{:.2f}", capture.shift_mm), fmt::format("{:.2f}", capture.rotation_deg),
+                  fmt::format("{:.2f}", capture.factor), capture.limited_by, Num(fixture.max_shift_mm),
+                  Num(fixture.max_rotation_deg));
   }
 }
 

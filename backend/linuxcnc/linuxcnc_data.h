@@ -39,7 +39,7 @@ inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 
                      kFxTripNominalAt = 29, kFxTripsAt = 30, kFxTrippedAt = 31, kFxCalibratedAt = 32,
                      kFxScanPathsAt = 33, kFxHasFix = 34, kFxFix = 35, kFxStatus = 41, kFxFailedTrip = 42,
                      kFxCheckValue = 43 /* + code 1..11 */, kFxCheckEvaluated = 55 /* + code */, kFxS = 67,
-                     kFxScale = 73, kFxRecordSize = 80;
+                     kFxScale = 73, kFxLatchFeed = 74, kFxRecordSize = 80;
 // Region record offsets.
 inline constexpr int kRgXLo = 0, kRgXHi = 1, kRgYLo = 2, kRgYHi = 3, kRgDomain = 4, kRgContraction = 8,
                      kRgIterationBound = 9, kRgOutside = 10, kRgDxAt = 11, kRgDyAt = 12, kRgRecordSize = 13;
@@ -52,6 +52,12 @@ std::optional<std::string> LinuxCncDataProblem(const cell::Cell& cell);
 // The text of smtcal_data.ngc for the cell (deterministic; the cell must fit:
 // checked).
 std::string EmitLinuxCncData(const cell::Cell& cell);
+
+// What identifies the runtime of a compile: smtcal's version, its runtime
+// files, the cell's data and abort messages (FNV-1a, 31 bits: an integer
+// rs274 holds exactly). smtcal_data.ngc sets #<_smtcal_runtime_id> to it;
+// the main program refuses to run with another.
+long LinuxCncRuntimeId(const cell::Cell& cell);
 
 // A number as rs274 reads it back exactly: a plain decimal (no exponent) with
 // the fewest decimals that round-trip, correctly rounded; "0" for zero.
