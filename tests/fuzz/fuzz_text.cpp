@@ -2,9 +2,11 @@
 // bytes through the one check of numbers (base/number_range.h) and the one
 // quoting function (base/field_text.h). Properties: a number accepted is
 // finite and in its range, and reads back; what Printable and a diagnostic
-// give is valid UTF-8 (decoded here on its own, not with Utf8Length), the
+// give is valid UTF-8 (decoded by the tests' own oracle,
+// tests/unit/utf8_oracle.h, not with Utf8Length), the
 // source-line form keeps one character per character, and a message is cut
 // at its limit.
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -13,32 +15,12 @@
 #include "base/field_text.h"
 #include "base/number_range.h"
 #include "tests/fuzz/fuzz_target.h"
+#include "tests/unit/utf8_oracle.h"
 
 namespace {
 
-// Well-formed UTF-8, decoded code point by code point; also counts them.
 bool Utf8Characters(std::string_view text, std::size_t* characters) {
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < text.size(); ++count) {
-    const auto lead = static_cast<unsigned char>(text[i]);
-    if (lead < 0x80) {
-      ++i;
-      continue;
-    }
-    std::size_t n = (lead & 0xE0) == 0xC0 ? 2 : (lead & 0xF0) == 0xE0 ? 3 : (lead & 0xF8) == 0xF0 ? 4 : 0;
-    if (n == 0 || i + n > text.size()) return false;
-    std::uint32_t code = lead & (0x7Fu >> n);
-    for (std::size_t k = 1; k < n; ++k) {
-      const auto next = static_cast<unsigned char>(text[i + k]);
-      if ((next & 0xC0) != 0x80) return false;
-      code = (code << 6) | (next & 0x3Fu);
-    }
-    const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
-    if (code < least[n] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
-    i += n;
-  }
-  if (characters != nullptr) *characters = count;
-  return true;
+  return smtcal::test::IsWellFormedUtf8(text, characters);
 }
 
 // The characters of arbitrary bytes as Printable's kSourceLine walks them:

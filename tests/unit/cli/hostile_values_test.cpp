@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/unit/test_support.h"
+#include "tests/unit/utf8_oracle.h"
 
 namespace smtcal {
 namespace {
@@ -41,39 +42,7 @@ std::string Quote(const std::string& text) {
 }
 std::string Q(const fs::path& path) { return Quote(path.string()); }
 
-// Well-formed UTF-8, decoded code point by code point (an implementation of
-// its own, not base/field_text.h's table): no overlong form, no surrogate,
-// nothing beyond U+10FFFF.
-bool IsValidUtf8(std::string_view text) {
-  for (std::size_t i = 0; i < text.size();) {
-    const auto lead = static_cast<unsigned char>(text[i]);
-    if (lead < 0x80) {
-      ++i;
-      continue;
-    }
-    std::size_t n = 0;
-    std::uint32_t code = 0;
-    if ((lead & 0xE0) == 0xC0) {
-      n = 2, code = lead & 0x1Fu;
-    } else if ((lead & 0xF0) == 0xE0) {
-      n = 3, code = lead & 0x0Fu;
-    } else if ((lead & 0xF8) == 0xF0) {
-      n = 4, code = lead & 0x07u;
-    } else {
-      return false;
-    }
-    if (i + n > text.size()) return false;
-    for (std::size_t k = 1; k < n; ++k) {
-      const auto next = static_cast<unsigned char>(text[i + k]);
-      if ((next & 0xC0) != 0x80) return false;
-      code = (code << 6) | (next & 0x3Fu);
-    }
-    const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
-    if (code < least[n] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
-    i += n;
-  }
-  return true;
-}
+using test::IsWellFormedUtf8;
 
 // A scratch folder for each test, removed after it.
 class Hostile : public testing::Test {
@@ -435,7 +404,7 @@ TEST_F(Hostile, StandardErrorIsAlwaysValidUtf8) {
     for (const char* format : {"", "--diagnostics=json "}) {
       SmtcalRun run = Smtcal(format + command);
       EXPECT_NE(run.exit_code, 0) << format << command;
-      EXPECT_TRUE(IsValidUtf8(run.err)) << format << command << "\n" << run.err;
+      EXPECT_TRUE(IsWellFormedUtf8(run.err)) << format << command << "\n" << run.err;
       EXPECT_EQ(run.err.find('\x1b'), std::string::npos) << format << command << ": a raw escape reached the terminal";
       if (*format != '\0') {
         EXPECT_TRUE(nlohmann::json::accept(run.err)) << command << "\n" << run.err;
