@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "base/check.h"
+#include "calibration/limits.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
@@ -92,8 +93,20 @@ std::optional<AxisTable> AxisAssembly::Run() {
     return static_cast<std::size_t>(it - lines.begin());
   };
 
-  // Which grid nodes have a row (first row wins; later ones are duplicates).
+  // A table's lines are crossed into nx x ny nodes, each with a row: far
+  // fewer rows than that is not a grid with holes but no grid at all (rows
+  // on a diagonal make n^2 nodes of n rows). Said once, before the nodes are
+  // laid out, so the work stays in proportion to the rows (calibration/limits.h).
   const std::size_t nx = xs.size(), ny = ys.size();
+  const double nodes_needed = static_cast<double>(nx) * static_cast<double>(ny);
+  const double rows_given = static_cast<double>(members.size());
+  if (nodes_needed - rows_given > static_cast<double>(limits::kMaxMissingNodesListed)) {
+    diags.Report(DiagKind::TableGridIncomplete, nodes[members.front()].x_field, name, nx, ny,
+                 fmt::format("{:.0f}", nodes_needed), members.size(), fmt::format("{:.0f}", nodes_needed - rows_given));
+    return std::nullopt;
+  }
+
+  // Which grid nodes have a row (first row wins; later ones are duplicates).
   std::vector<std::optional<std::size_t>> at(nx * ny);
   std::vector<std::size_t> strays;
   for (std::size_t k : members) {

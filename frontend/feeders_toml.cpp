@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "base/field_text.h"
+#include "base/number_range.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_text.h"
@@ -84,23 +85,29 @@ class Reader {
     return *node->value<std::string>();
   }
 
-  std::optional<double> Number(const toml::table& table, std::string_view key, double limit, std::string_view unit) {
+  // A number in `range`: the one check of base/number_range.h.
+  std::optional<double> NumberOf(const toml::node& node, const std::string& label, const NumberRange& range) {
+    const double value = TomlNumber(node);
+    if (!InRange(value, range)) {
+      diags_.Report(DiagKind::FeedersBadValue, Range(node), label, RangeText(range), TomlNumberText(node));
+      return std::nullopt;
+    }
+    return value + 0.0;  // -0 as 0
+  }
+
+  std::optional<double> Number(const toml::table& table, std::string_view key, const NumberRange& range) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_number()) {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a number", TomlTypeName(*node));
       return std::nullopt;
     }
-    double value = *node->value<double>();
-    if (!std::isfinite(value) || std::abs(value) > limit) {
-      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, fmt::format("within ±{} {}", limit, unit),
-                    fmt::format("{}", value));
-      return std::nullopt;
-    }
-    return value;
+    return NumberOf(*node, std::string(key), range);
   }
 
-  std::optional<int> Count(const toml::table& table, std::string_view key, SourceRange* range = nullptr) {
+  // A whole number in `whole`: pallet columns or rows, a lane.
+  std::optional<int> Count(const toml::table& table, std::string_view key, const NumberRange& whole,
+                           SourceRange* range = nullptr) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (range != nullptr) *range = Range(*node);
@@ -108,12 +115,9 @@ class Reader {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a whole number", TomlTypeName(*node));
       return std::nullopt;
     }
-    std::int64_t value = *node->value<std::int64_t>();
-    if (value < 1 || value > (1 << 20)) {
-      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, "a whole number of at least 1", value);
-      return std::nullopt;
-    }
-    return static_cast<int>(value);
+    std::optional<double> value = NumberOf(*node, std::string(key), whole);
+    if (!value) return std::nullopt;
+    return static_cast<int>(*value);
   }
 
   // [x, y, z, u]: mm and degrees in the robot base frame.
@@ -128,14 +132,11 @@ class Reader {
       return std::nullopt;
     }
     std::array<double, 4> point{};
-    for (std::size_t i = 0; i < 4; ++i) point[i] = *array->get(i)->value<double>();
     for (std::size_t i = 0; i < 4; ++i) {
-      double limit = i == 3 ? limits::kMaxAbsAngleDeg : kMaxLengthMm;
-      if (!std::isfinite(point[i]) || std::abs(point[i]) > limit) {
-        diags_.Report(DiagKind::FeedersBadValue, Range(*array->get(i)), fmt::format("{}[{}]", key, i + 1),
-                      fmt::format("within ±{} {}", limit, i == 3 ? "deg" : "mm"), fmt::format("{}", point[i]));
-        return std::nullopt;
-      }
+      std::optional<double> value = NumberOf(*array->get(i), fmt::format("{}[{}]", key, i + 1),
+                                             i == 3 ? limits::kAngleDeg : limits::kPositionMm);
+      if (!value) return std::nullopt;
+      point[i] = *value;
     }
     return point;
   }
@@ -162,15 +163,14 @@ class Reader {
       }
     }
     if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
-    feeder.rotation_offset_deg =
-        Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    feeder.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
     if (const toml::node* node = table.get("pallet")) {
       if (const toml::table* pallet = node->as_table()) {
         CheckKeys(*pallet, "the pallet", {"last", "back", "columns", "rows"});
         feeder.pallet_last = Point(*pallet, "last");
         feeder.pallet_back = Point(*pallet, "back");
-        feeder.columns = Count(*pallet, "columns").value_or(1);
-        feeder.rows = Count(*pallet, "rows").value_or(1);
+        feeder.columns = Count(*pallet, "columns", limits::kPalletCount).value_or(1);
+        feeder.rows = Count(*pallet, "rows", limits::kPalletCount).value_or(1);
         for (std::string_view key : {"last", "back", "columns", "rows"}) {
           if (!pallet->contains(key)) {
             diags_.Report(DiagKind::FeedersMissingKey, Range(*node), "the pallet", fmt::format("'{}'", key));
@@ -213,8 +213,8 @@ class Reader {
       diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]",
                     "'package', 'value' or 'designator' to say which parts it maps");
     }
-    rule.lane = Count(table, "lane", &rule.lane_range);
-    rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    rule.lane = Count(table, "lane", limits::kPalletPickPoint, &rule.lane_range);
+    rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
     if (diags_.error_count() != errors_before) return std::nullopt;
     return rule;
   }

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <numbers>
 
+#include "base/check.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/limits.h"
 #include "simulation/sim_random.h"
 
 namespace smtcal {
@@ -84,14 +86,24 @@ TrueField::TrueField(const cell::Cell& cell, const TruthSpec& spec, std::uint64_
     }
   }
   // Scaled so that its largest magnitude over the robot's reach (on a grid of
-  // L / 8) is A: the field reaches the declared size, and no more.
+  // L / 8) is A: the field reaches the declared size, and no more. The
+  // grid's size was bounded by the cell and truth loaders
+  // (calibration/truth_spec.h); counted in integers, so a step far below
+  // the coordinates' resolution cannot stall the loop.
   field_scale_ = 1;
   const cell::Interval& xs = cell.robot.limits[0];
   const cell::Interval& ys = cell.robot.limits[1];
-  const double step = correlation_mm_ / 8;
+  SMTCAL_CHECK(TrueFieldSamples(cell.robot, correlation_mm_) <= limits::kMaxTrueFieldSamples,
+               "the true field's grid is larger than the loaders allow");
+  const double step = TrueFieldStepMm(correlation_mm_);
+  const long nx = static_cast<long>(TrueFieldSamplesAlong(xs, correlation_mm_));
+  const long ny = static_cast<long>(TrueFieldSamplesAlong(ys, correlation_mm_));
   double largest = 0;
-  for (double x = xs.lo; x <= xs.hi + 1e-9; x += step) {
-    for (double y = ys.lo; y <= ys.hi + 1e-9; y += step) largest = std::max(largest, Uncalibrated({x, y}).norm());
+  for (long i = 0; i < nx; ++i) {
+    for (long j = 0; j < ny; ++j) {
+      const Eigen::Vector2d n(xs.lo + static_cast<double>(i) * step, ys.lo + static_cast<double>(j) * step);
+      largest = std::max(largest, Uncalibrated(n).norm());
+    }
   }
   field_scale_ = largest > 0 ? accuracy_mm_ / largest : 0.0;
 }

@@ -38,8 +38,7 @@ void AddCheckCommand(CLI::App& app, GlobalOptions& options) {
     if (!diags.has_errors()) {
       Status ran = RunPasses(program, diags, passes, verify_each);
       if (!ran) {  // not expected: --passes was validated while parsing the command line
-        fmt::print(stderr, "smtcal: error: {}\n", ran.error().message);
-        options.exit_code = kExitUsageError;
+        options.exit_code = ReportUsageError(ran.error().message);
         return;
       }
     }

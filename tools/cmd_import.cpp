@@ -72,44 +72,42 @@ std::string BaseName(const std::string& path) {
   return path == "-" ? "<stdin>" : std::filesystem::path(path).filename().string();
 }
 
-// "X,Y" -> two finite lengths within kMaxLengthMm.
-std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
+// "X,Y" -> two positions in mm (limits::kPositionMm), or why not. Each
+// number goes through the one check of base/number_range.h.
+Result<std::array<double, 2>> ParsePair(const std::string& text) {
   std::size_t comma = text.find(',');
-  if (comma == std::string::npos) return std::nullopt;
-  std::optional<double> a = ParseNumber(text.substr(0, comma));
-  std::optional<double> b = ParseNumber(text.substr(comma + 1));
-  if (!a || !b || !std::isfinite(*a) || !std::isfinite(*b) || std::abs(*a) > kMaxLengthMm ||
-      std::abs(*b) > kMaxLengthMm) {
-    return std::nullopt;
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos) {
+    return Error{"expected X,Y in mm: two numbers with a comma between them and no space, e.g. 10.5,20 or -5,10"};
   }
-  return std::array<double, 2>{*a, *b};
+  Result<double> a = ParseNumberIn(std::string_view(text).substr(0, comma), limits::kPositionMm);
+  if (!a) return Error{"X: " + a.error().message};
+  Result<double> b = ParseNumberIn(std::string_view(text).substr(comma + 1), limits::kPositionMm);
+  if (!b) return Error{"Y: " + b.error().message};
+  return std::array<double, 2>{a.value(), b.value()};
 }
 
 CLI::Validator PairValidator() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {
-        return ParsePair(text) ? std::string() : "expected X,Y in mm: two numbers with a comma between them and no "
-                                                 "space, e.g. 10.5,20 or -5,10";
+        Result<std::array<double, 2>> pair = ParsePair(text);
+        return pair ? std::string() : pair.error().message;
       },
-      "X,Y");
+      "");
 }
 
-// "CxR" -> columns and rows of a panel.
-std::optional<std::array<int, 2>> ParsePanel(const std::string& text) {
+// "CxR" -> columns and rows of a panel, or why not.
+Result<std::array<int, 2>> ParsePanel(const std::string& text) {
   std::size_t x = text.find_first_of("xX");
-  if (x == std::string::npos) return std::nullopt;
-  try {
-    std::size_t used = 0;
-    int columns = std::stoi(text.substr(0, x), &used);
-    if (used != x) return std::nullopt;
-    int rows = std::stoi(text.substr(x + 1), &used);
-    if (used != text.size() - x - 1 || columns < 1 || rows < 1 || columns * static_cast<long>(rows) > 10000) {
-      return std::nullopt;
-    }
-    return std::array<int, 2>{columns, rows};
-  } catch (const std::exception&) {
-    return std::nullopt;
+  if (x == std::string::npos) return Error{"expected CxR, e.g. 3x2"};
+  Result<WholeNumber> columns = ParseWholeNumberIn(std::string_view(text).substr(0, x), limits::kPalletCount);
+  if (!columns) return Error{"C: " + columns.error().message};
+  Result<WholeNumber> rows = ParseWholeNumberIn(std::string_view(text).substr(x + 1), limits::kPalletCount);
+  if (!rows) return Error{"R: " + rows.error().message};
+  const long boards = static_cast<long>(columns.value().magnitude * rows.value().magnitude);
+  if (boards > limits::kMaxPanelBoards) {
+    return Error{fmt::format("{} boards; a panel has at most {}", boards, limits::kMaxPanelBoards)};
   }
+  return std::array<int, 2>{static_cast<int>(columns.value().magnitude), static_cast<int>(rows.value().magnitude)};
 }
 
 std::optional<char> ParseDelimiter(const std::string& text) {
@@ -211,10 +209,10 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   if (opt.bottom_positions == "negated-x") import.bottom_positions = cad::BottomPositions::kNegatedX;
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
-  std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : *ParsePair(opt.origin);
-  std::array<double, 2> pitch = *ParsePair(opt.pitch);
+  std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : ParsePair(opt.origin).value();
+  std::array<double, 2> pitch = ParsePair(opt.pitch).value();
   import.origin_given = !opt.origin.empty();
-  std::array<int, 2> panel = *ParsePanel(opt.panel);
+  std::array<int, 2> panel = ParsePanel(opt.panel).value();
   import.origin_x_mm = origin[0];
   import.origin_y_mm = origin[1];
   import.rotation_deg = opt.rotation_deg;
@@ -241,9 +239,7 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
 
 void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
-  std::vector<std::string> inputs = {opt.list, opt.cell};
-  if (!opt.feeders.empty()) inputs.push_back(opt.feeders);
-  if (OutputOverwritesInput("-o", opt.output, inputs)) {
+  if (FilesClash({{"LIST", opt.list}, {"--cell", opt.cell}, {"--feeders", opt.feeders}}, {{"-o", opt.output}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -331,20 +327,20 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
                            place_z, place_z_source);
   }
   if (options.exit_code != kExitOk || !program) {
-    std::fputs(summary.c_str(), stderr);
+    SaySummary(summary);
     options.exit_code = kExitInputError;
     return;  // nothing half-written
   }
   Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
   if (!written) {
-    std::fputs(summary.c_str(), stderr);
+    SaySummary(summary);
     options.exit_code = ReportIoError(written.error());
     return;
   }
   if (opt.output != "-") {
     summary += fmt::format("  next:    smtcal verify {} --cell {}\n", ShellWord(opt.output), ShellWord(opt.cell));
   }
-  std::fputs(summary.c_str(), stderr);
+  SaySummary(summary);
 }
 
 }  // namespace
@@ -393,11 +389,13 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   // Where the board is.
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
-                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
-                  "on the largest calibrated region on the fixture, else 0,0)")
-      ->check(PairValidator());
-  cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
-      ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
+                  fmt::format("X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (each {}; default: the "
+                              "parts centred\non the largest calibrated region on the fixture, else 0,0)",
+                              RangeText(limits::kPositionMm)))
+      ->check(PairValidator())
+      ->type_name("X,Y");
+  AddNumberOption(*cmd, "--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)",
+                  limits::kAngleDeg);
   cmd->add_option("--mirror", opt.mirror,
                   "the board coordinate that changes sign: none, x or y (default: none for the top side, x for\n"
                   "the bottom side, the board turned over about its y axis)")
@@ -412,22 +410,30 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
                   "mirrored with the positions) or bottom-view (as seen from below, kept)")
       ->check(CLI::IsMember({"top-view", "bottom-view"}))
       ->capture_default_str();
-  cmd->add_option("--panel", opt.panel, "CxR: a panel of C columns and R rows of boards (default 1x1)")
+  cmd->add_option("--panel", opt.panel,
+                  fmt::format("CxR: a panel of C columns and R rows of boards (default 1x1; each {}, at most {} "
+                              "boards)",
+                              RangeText(limits::kPalletCount), limits::kMaxPanelBoards))
       ->check(CLI::Validator(
           [](const std::string& text) {
-            return ParsePanel(text) ? std::string() : "expected CxR, e.g. 3x2 (at most 10000 boards)";
+            Result<std::array<int, 2>> panel = ParsePanel(text);
+            return panel ? std::string() : panel.error().message;
           },
-          "CxR"));
-  cmd->add_option("--pitch", opt.pitch, "DX,DY: the distance between the panel's boards along its x and y, mm")
-      ->check(PairValidator());
-  cmd->add_option("--place-z", opt.place_z_mm,
+          ""))
+      ->type_name("CxR");
+  cmd->add_option("--pitch", opt.pitch,
+                  fmt::format("DX,DY: the distance between the panel's boards along its x and y, mm (each {})",
+                              RangeText(limits::kPositionMm)))
+      ->check(PairValidator())
+      ->type_name("X,Y");
+  AddNumberOption(*cmd, "--place-z", opt.place_z_mm,
                   "z of the placements, mm: the robot z of the board's top (default: the fixture's place_z_mm\n"
-                  "in the cell; without either it is an error)")
-      ->check(CLI::Range(-kMaxLengthMm, kMaxLengthMm));
+                  "in the cell; without either it is an error)",
+                  limits::kPositionMm);
 
   // The program.
-  cmd->add_option("--vacuum", opt.vacuum, "the gripper's vacuum output, the program's Vacuum (default 8)")
-      ->check(CLI::Range(limits::kVacuumOutputMin, limits::kVacuumOutputMax))
+  AddNumberOption(*cmd, "--vacuum", opt.vacuum, "the gripper's vacuum output, the program's Vacuum (default 8)",
+                  limits::kVacuumOutput)
       ->capture_default_str();
   cmd->add_option("--angles", opt.angles, "rotations in the program: signed (-180..180) or positive (0..360)")
       ->check(CLI::IsMember({"signed", "positive"}))

@@ -10,6 +10,7 @@
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
 #include "calibration/inverse_calibration.h"
+#include "calibration/limits.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
 
@@ -19,6 +20,7 @@ namespace {
 struct TableOptions {
   std::string input;   // the table (or raw file for build)
   std::string points = "-";
+  bool points_given = false;
   std::string output = "-";
   bool json = false;
   std::string outside = "error";
@@ -65,15 +67,18 @@ OutsidePolicy ParsePolicy(const std::string& name) {
   return OutsidePolicy::kError;
 }
 
-// The output options of `table` never name the command's own inputs.
-bool OutputIsInput(const TableOptions& opt, GlobalOptions& options) {
-  if (!OutputOverwritesInput("-o", opt.output, {opt.input, opt.points})) return false;
+// The files of a `table` command against each other (tools/commands.h):
+// POINTS is standard input unless given, so `table inverse -` clashes too.
+bool FilesClashIn(const TableOptions& opt, bool with_points, GlobalOptions& options) {
+  std::vector<NamedFile> inputs = {{"TABLE", opt.input}};
+  if (with_points) inputs.push_back({opt.points_given ? "POINTS" : "POINTS (standard input unless given)", opt.points});
+  if (!FilesClash(inputs, {{"-o", opt.output}})) return false;
   options.exit_code = kExitUsageError;
   return true;
 }
 
 void RunBuild(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Result<std::uint32_t> file = sources.Load(opt.input);
   if (!file) {
@@ -115,7 +120,7 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, true, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   TableAnalysis analysis;
@@ -164,7 +169,7 @@ void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
 }
 
 void RunPlot(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
@@ -208,8 +213,9 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                 : "Direct calibration: the actual positions F(n) = n + Delta(n) the robot reaches when\n"
                   "commanded to n; prints x_mm,y_mm,residual_mm,iterations (residual and iterations 0)");
     solve->add_option("TABLE", opt.input, "the error table CSV")->required();
-    solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
-        ->capture_default_str();
+    CLI::Option* points =
+        solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
+            ->capture_default_str();
     solve->add_option("-o,--output", opt.output, "where to write the results ('-' for stdout)")
         ->capture_default_str();
     solve->add_option("--outside", opt.outside,
@@ -223,12 +229,14 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                         "or paper (the paper's iterative interval search)")
           ->check(CLI::IsMember({"default", "paper"}))
           ->capture_default_str();
-      solve->add_option("--paper-tolerance", opt.paper_tolerance_mm,
-                        "the paper solver's stopping tolerance in mm")
-          ->check(CLI::PositiveNumber)
+      AddNumberOption(*solve, "--paper-tolerance", opt.paper_tolerance_mm, "the paper solver's stopping tolerance",
+                      limits::kPaperToleranceMm)
           ->capture_default_str();
     }
-    solve->callback([&options, inverse] { RunSolve(opt, options, inverse); });
+    solve->callback([&options, inverse, points] {
+      opt.points_given = points->count() > 0;
+      RunSolve(opt, options, inverse);
+    });
   }
 
   CLI::App* plot = table->add_subcommand(

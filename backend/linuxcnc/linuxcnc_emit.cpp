@@ -1079,6 +1079,17 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                d.target_.string(), why)};
     }
   }
+  // The temporaries of killed runs go first, as a file output's do: a
+  // folder "OUTDIR.tmp.PID" of a process that no longer runs, holding the
+  // subroutines/ folder Open() makes first.
+  const std::string prefix = d.target_.filename().string() + ".tmp.";
+  const fs::path parent = d.target_.has_parent_path() ? d.target_.parent_path() : fs::path(".");
+  RemoveStaleTemporaries(parent.string(), prefix, [](const std::string& stale) {
+    std::error_code ignored;
+    if (fs::is_directory(fs::symlink_status(stale, ignored)) && fs::is_directory(fs::path(stale) / "subroutines", ignored)) {
+      fs::remove_all(stale, ignored);
+    }
+  });
   d.temp_ = d.target_;
   d.temp_ += fmt::format(".tmp.{}", ::getpid());
   fs::remove_all(d.temp_, error);

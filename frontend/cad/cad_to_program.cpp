@@ -458,6 +458,15 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
     summary_.failed = true;
     return std::nullopt;
   }
+  // The program's size is asked for by the list and the panel together:
+  // bounded before it is built (calibration/limits.h).
+  const double placements = static_cast<double>(placed.size()) * static_cast<double>(summary_.boards);
+  if (placements > static_cast<double>(limits::kMaxImportedPlacements)) {
+    diags_.Report(DiagKind::ImportTooManyPlacements, SourceRange(SourceLoc{list_file_, 0, 0}), placed.size(),
+                  options_.columns, options_.rows, fmt::format("{:.0f}", placements), limits::kMaxImportedPlacements);
+    summary_.failed = true;
+    return std::nullopt;
+  }
   cad::BottomPositions bottom_positions = cad::BottomPositions::kTopView;
   if (side == cad::Side::kBottom) bottom_positions = DescribeBottom(reader);
   std::optional<ir::Program> program = Build(placed, side, bottom_positions);
