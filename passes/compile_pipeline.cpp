@@ -26,6 +26,7 @@ Result<bool> CompileForCell(std::uint32_t program_file, const std::string& cell_
   if (diags.has_errors() || !out.cell) return false;
   out.program.compile = std::make_shared<CompileState>();
   out.program.compile->cell = &*out.cell;
+  out.program.compile->report_budget_findings = out.report_budget_findings;
   std::vector<const PassInfo*> corrections;
   for (const PassInfo& info : CorrectionPassRegistry()) corrections.push_back(&info);
   RunPasses(out.program, diags, corrections, verify_each);

@@ -21,6 +21,8 @@ namespace smtcal {
 struct CompiledProgram {
   ir::Program program;
   std::optional<cell::Cell> cell;
+  // Set before CompileForCell: CompileState::report_budget_findings.
+  bool report_budget_findings = true;
 };
 
 // Parses and checks the program in `program_file` (loaded into `sources`),
