@@ -10,7 +10,6 @@
 #include "backend/place/place_printer.h"
 #include "backend/reports/compile_report.h"
 #include "calibration/cell.h"
-#include "frontend/cell_toml.h"
 #include "frontend/parse.h"
 #include "ir/ir_ops.h"
 #include "passes/correction/compile_state.h"
@@ -75,7 +74,6 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   Diagnostics diags(sources);
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
-  cell::ReportTableWarnings(*compiled.cell, diags);
   const CompileState& state = *compiled.program.compile;
   // The LinuxCNC emitter reports what it cannot lower with the passes'
   // diagnostics; it writes the main program as it goes (into the output
@@ -151,7 +149,6 @@ void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
   Diagnostics diags(sources);
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
-  cell::ReportTableWarnings(*compiled.cell, diags);
   options.exit_code = PrintDiagnostics(diags, options);
   const CompileState& state = *compiled.program.compile;
   std::string text = opt.json ? JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags)))
