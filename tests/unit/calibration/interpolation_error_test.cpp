@@ -7,6 +7,7 @@
 // (printed on failure).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
 #include <random>
@@ -261,6 +262,8 @@ TEST(InterpolationError, GridAdviceScalesWithThePitchSquared) {
 // cell centre. The estimate from them must bound the true departure.
 TEST(InterpolationErrorProperty, CheckPointsBoundTheTrueDepartureAtFourSigma) {
   const std::uint64_t seed = test::FixtureSeed();
+  std::printf("interpolation property seed: %llu (set SMTCAL_TEST_SEED to vary it)\n",
+              static_cast<unsigned long long>(seed));
   SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
   std::mt19937_64 rng(seed);
   struct Grid {
@@ -291,6 +294,7 @@ TEST(InterpolationErrorProperty, CheckPointsBoundTheTrueDepartureAtFourSigma) {
     }
   }
   RecordProperty("worst_truth_over_estimate", fmt::format("{:.3f}", worst_ratio));
+  std::printf("largest true departure / estimate: %.3f\n", worst_ratio);
   EXPECT_EQ(fields, 96);
 }
 
