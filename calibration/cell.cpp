@@ -38,6 +38,15 @@ const Region* Cell::RegionAt(const Point2& p) const {
   return nullptr;
 }
 
+std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot) {
+  if (!robot.uncalibrated_accuracy_mm) return std::nullopt;
+  return DeclaredRoughness{*robot.uncalibrated_accuracy_mm, robot.uncalibrated_correlation_mm};
+}
+
+InterpolationEstimate RegionInterpolation(const Robot& robot, const ErrorTable& table) {
+  return EstimateInterpolationError(table, DeclaredRoughnessOf(robot), robot.repeatability_mm);
+}
+
 std::string_view EstimatorName(Estimator estimator) { return kEstimatorNames[static_cast<std::size_t>(estimator)]; }
 std::string_view TaskAxisName(TaskAxis axis) { return kTaskAxisNames[static_cast<std::size_t>(axis)]; }
 std::string_view OutsidePolicyName(OutsidePolicy policy) { return kOutsideNames[static_cast<std::size_t>(policy)]; }

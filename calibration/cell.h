@@ -26,6 +26,7 @@
 
 #include "base/source.h"
 #include "calibration/error_table.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 
 namespace smtcal::cell {
@@ -76,6 +77,15 @@ struct Robot {
   SourceRange range;        // the [robot] table
 };
 
+// What the robot declares about the roughness of its error
+// (uncalibrated_accuracy_mm over uncalibrated_correlation_mm); nullopt when
+// it declares no accuracy.
+std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot);
+// The interpolation error of a region's table in this robot's cell: with the
+// robot's declared roughness, and a node that states no noise counted as one
+// measurement with the robot's repeatability (as the budget does).
+InterpolationEstimate RegionInterpolation(const Robot& robot, const ErrorTable& table);
+
 // The axes a region's difficulty measure names.
 enum class TaskAxis { X, Y, Z, U };
 
@@ -100,6 +110,9 @@ struct Region {
   SourceRange table_range;
   ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
   Rect domain;             // TableDomain(table): where F is defined
+  // How far the robot's error may depart from the table's interpolation
+  // between its nodes: RegionInterpolation(robot, table), set by the loader.
+  InterpolationEstimate interpolation;
   double tolerance_mm = 0;  // the task tolerance: +- this around the required position
   SourceRange tolerance_range;
   OutsidePolicy outside = OutsidePolicy::kError;  // policy for points outside the grid

@@ -15,11 +15,14 @@
 
 #include "base/check.h"
 #include "calibration/limits.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
 
 std::string_view AxisName(TableAxis axis) { return axis == TableAxis::X ? "x" : "y"; }
+
+std::string_view ReadingKindName(ReadingKind kind) { return kind == ReadingKind::kNode ? "node" : "check"; }
 
 std::string FormatMm(double mm) {
   if (mm == 0) mm = 0;  // no "-0.000"
@@ -230,6 +233,45 @@ std::optional<AxisTable> AxisAssembly::Run() {
   return table;
 }
 
+// The check points of an assembled axis table: inside its grid's rectangle,
+// away from the nodes, one per position; sorted by y, then x.
+bool AddCheckPoints(AxisTable& table, TableAxis axis, const std::vector<TableNode>& nodes,
+                    const std::vector<std::size_t>& checks, Diagnostics& diags) {
+  const std::string_view name = AxisName(axis);
+  const std::size_t errors_before = diags.error_count();
+  std::map<std::pair<double, double>, std::size_t> seen;  // (y, x) -> index into nodes
+  for (std::size_t k : checks) {
+    const TableNode& check = nodes[k];
+    const double x0 = table.xs.front(), x1 = table.xs.back(), y0 = table.ys.front(), y1 = table.ys.back();
+    if (check.x_mm < x0 || check.x_mm > x1 || check.y_mm < y0 || check.y_mm > y1) {
+      diags.Report(DiagKind::TableCheckOutsideGrid, check.x_field, FormatMm(check.x_mm), FormatMm(check.y_mm), name,
+                   FormatMm(x0), FormatMm(x1), FormatMm(y0), FormatMm(y1));
+      continue;
+    }
+    const CellPlace place = PlaceInCell(table, check.x_mm, check.y_mm);
+    if (place.CentreShare() < kMinCheckPointShare) {
+      const std::size_t i = place.i + (place.s > 0.5 ? 1 : 0), j = place.j + (place.t > 0.5 ? 1 : 0);
+      const bool on = table.xs[i] == check.x_mm && table.ys[j] == check.y_mm;
+      diags.Report(DiagKind::TableCheckNearNode, check.x_field, FormatMm(check.x_mm), FormatMm(check.y_mm), name,
+                   on ? "on" : "too near", FormatMm(table.xs[i]), FormatMm(table.ys[j]),
+                   fmt::format("{:.0f}", 100 * place.CentreShare()), fmt::format("{:.0f}", 100 * kMinCheckPointShare),
+                   FormatMm(0.5 * (table.xs[place.i] + table.xs[place.i + 1])),
+                   FormatMm(0.5 * (table.ys[place.j] + table.ys[place.j + 1])));
+      continue;
+    }
+    auto [it, inserted] = seen.emplace(std::make_pair(check.y_mm, check.x_mm), k);
+    if (!inserted) {
+      const TableNode& first = nodes[it->second];
+      Diagnostic* diag = diags.Report(DiagKind::TableDuplicateCheck, check.x_field, FormatMm(check.x_mm),
+                                      FormatMm(check.y_mm), name, LineOf(first.x_field));
+      Diagnostics::AddNote(diag, first.x_field, "first given here");
+    }
+  }
+  if (diags.error_count() != errors_before) return false;
+  for (const auto& [position, k] : seen) table.checks.push_back(nodes[k]);
+  return true;
+}
+
 }  // namespace
 
 std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector<TableNode>& nodes,
@@ -239,8 +281,10 @@ std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector
   bool ok = true;
   for (TableAxis axis : kTableAxes) {
     AxisAssembly assembly{axis, nodes, {}, diags};
+    std::vector<std::size_t> checks;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
-      if (nodes[k].axis == axis) assembly.members.push_back(k);
+      if (nodes[k].axis != axis) continue;
+      (nodes[k].kind == ReadingKind::kNode ? assembly.members : checks).push_back(k);
     }
     if (assembly.members.empty()) {
       diags.Report(DiagKind::TableMissingAxis, SourceRange(SourceLoc{file.file, 0, 0}), AxisName(axis));
@@ -248,7 +292,7 @@ std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector
       continue;
     }
     std::optional<AxisTable> axis_table = assembly.Run();
-    if (!axis_table) {
+    if (!axis_table || !AddCheckPoints(*axis_table, axis, nodes, checks, diags)) {
       ok = false;
       continue;
     }

@@ -57,6 +57,9 @@ struct TruthSpec {
   std::string path;  // the truth file; empty: defaults
   TruthTables tables = TruthTables::kDerived;
   double perturbation_scale = 1;  // derived: multiplies each node's standard error
+  // derived: multiplies the departure between the nodes, whose size is the
+  // region's interpolation estimate (cell::Region::interpolation)
+  double interpolation_scale = 1;
   TruthOutside outside = TruthOutside::kField;
   double fade_mm = 10;
   // The field's size and correlation length; default: the cell's robot keys

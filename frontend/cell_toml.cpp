@@ -550,7 +550,8 @@ const Loader::LoadedTable& Loader::LoadTable(const std::string& table_path) {
     return loaded;
   }
   std::optional<ErrorTable> table = ReadErrorTable(file.value(), diags_);
-  // Warnings (sign changes, large errors) are for `smtcal table check`.
+  // Warnings (sign changes, large errors): `smtcal table check` shows each, and
+  // ReportTableWarnings sums them up for the commands that decide.
   if (table && ValidateErrorTable(*table, diags_, TableWarnings::kSkip)) {
     loaded.ok = true;
     loaded.table = std::move(*table);
@@ -1101,6 +1102,7 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   CheckUniqueNames(feeder_names, "feeder");
   CheckRegionOverlaps(cell.regions);
   if (diags_.error_count() != errors_before) return std::nullopt;
+  for (Region& region : cell.regions) region.interpolation = RegionInterpolation(cell.robot, region.table);
   return cell;
 }
 
@@ -1167,6 +1169,26 @@ static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostic
 
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags) {
   for (const Fixture& fixture : cell.fixtures) CheckScanErrors(fixture, cell, diags);
+}
+
+void ReportTableWarnings(const Cell& cell, Diagnostics& diags) {
+  std::vector<std::string> reported;  // table files, as loaded
+  for (const Region& region : cell.regions) {
+    if (std::find(reported.begin(), reported.end(), region.table.name) != reported.end()) continue;
+    reported.push_back(region.table.name);
+    std::string summary;
+    for (const std::string& line : SummarizeTableWarnings(region.table)) summary += (summary.empty() ? "" : "; ") + line;
+    if (summary.empty()) continue;
+    diags.Report(DiagKind::CellTableWarnings, region.table_range, Printable(region.table_path), Printable(region.name),
+                 summary, Printable(region.table.name));
+  }
+}
+
+void ReportGridAdvice(const Cell& cell, Diagnostics& diags) {
+  for (const Region& region : cell.regions) {
+    ReportCoarseGrid(region.interpolation, region.tolerance_mm,
+                     fmt::format("region '{}''s table", Printable(region.name)), region.table_range, diags);
+  }
 }
 
 }  // namespace smtcal::cell

@@ -28,4 +28,15 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
 // (CellTripLatency). verify covers both in its budgets.
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags);
 
+// The warnings of the cell's error tables (sign changes, errors over half the
+// pitch: what `smtcal table check` shows in full), summarised once per table
+// at the first region that uses it (CellTableWarnings): for the commands
+// that decide (cell check, verify, compile).
+void ReportTableWarnings(const Cell& cell, Diagnostics& diags);
+
+// The grid advice of every region whose interpolation estimate is more than
+// kInterpolationShareOfTolerance of its tolerance (InterpolationCoarse, at
+// its table key): for `smtcal cell check`.
+void ReportGridAdvice(const Cell& cell, Diagnostics& diags);
+
 }  // namespace smtcal::cell

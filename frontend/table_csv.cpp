@@ -33,9 +33,10 @@ struct Schema {
 };
 
 const Schema kTableSchema{
-    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
+    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n", "kind"}, 4, false};
 const Schema kRawSchema{
-    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
+    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm", "kind"}, 6,
+    false};
 const Schema kPointSchema{"a point list", "point", {"x_mm", "y_mm"}, 2, true};
 
 std::string JoinColumns(const Schema& schema, std::size_t count, std::string_view separator = ", ") {
@@ -173,6 +174,19 @@ class Row {
     if (name == "x") return TableAxis::X;
     if (name == "y") return TableAxis::Y;
     diags_.Report(DiagKind::TableBadAxis, field->range, Printable(field->text));
+    ok = false;
+    return std::nullopt;
+  }
+
+  // The optional `kind` column: node (also when the column or the field is
+  // empty) or check.
+  std::optional<ReadingKind> Kind(std::size_t column) {
+    const CsvField* field = Field(column);
+    if (field == nullptr || field->text.empty()) return ReadingKind::kNode;
+    std::string name = AsciiLowercase(field->text);
+    if (name == "node") return ReadingKind::kNode;
+    if (name == "check") return ReadingKind::kCheck;
+    diags_.Report(DiagKind::TableBadKind, field->range, Printable(field->text));
     ok = false;
     return std::nullopt;
   }
@@ -339,10 +353,11 @@ std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
 }
 
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kError, kStddev, kCount };
+  enum { kAxis, kX, kY, kError, kStddev, kCount, kKind };
   auto read_row = [&](Row& row, const CsvRecord&) -> std::optional<TableNode> {
     TableNode node;
     std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<ReadingKind> kind = row.Kind(kKind);
     std::optional<double> x = row.Number(kX), y = row.Number(kY), error = row.Number(kError);
     node.stddev_mm = row.Number(kStddev, true);
     std::optional<long long> count = row.Count(kCount, 1, true);
@@ -351,6 +366,7 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
       diags.Report(DiagKind::TableNegativeStddev, row.Range(kStddev), row.Field(kStddev)->text);
       return std::nullopt;
     }
+    node.kind = *kind;
     node.axis = *axis;
     node.x_mm = *x;
     node.y_mm = *y;
@@ -367,14 +383,16 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
 }
 
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kSet, kRepetition, kError };
+  enum { kAxis, kX, kY, kSet, kRepetition, kError, kKind };
   auto read_row = [](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
     std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<ReadingKind> kind = row.Kind(kKind);
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
     std::optional<double> error = row.Number(kError);
     if (!row.ok) return std::nullopt;
     RawMeasurement m;
+    m.kind = *kind;
     m.axis = *axis;
     m.x_mm = *x;
     m.y_mm = *y;

@@ -41,13 +41,13 @@ struct CsvRecord {
 // and left out.
 std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags);
 
-// An error table: axis,x_mm,y_mm,error_mm[,stddev_mm][,n], one row per node
-// and axis, rows in any order. Reports everything wrong with the rows and the
+// An error table: axis,x_mm,y_mm,error_mm[,stddev_mm][,n][,kind], one row
+// per node and axis (and per check point: kind = check), rows in any order. Reports everything wrong with the rows and the
 // grid (AssembleErrorTable); nullopt when anything was an error. The table is
 // not validated yet (ValidateErrorTable).
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags);
 
-// Raw measurements: axis,x_mm,y_mm,set,repetition,error_mm.
+// Raw measurements: axis,x_mm,y_mm,set,repetition,error_mm[,kind].
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags);
 
 // A point list: x_mm,y_mm (the header may be left out).

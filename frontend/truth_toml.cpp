@@ -69,12 +69,13 @@ class Reader {
  private:
   void ReadField(const toml::table& table, TruthSpec& spec) {
     CheckKeys(table, "[field]",
-              {"tables", "perturbation_scale", "outside", "fade_mm", "offset_mm", "rotation_deg", "about_mm",
-               "scale_ppm"});
+              {"tables", "perturbation_scale", "interpolation_scale", "outside", "fade_mm", "offset_mm",
+               "rotation_deg", "about_mm", "scale_ppm"});
     if (std::optional<int> tables = Choice(table, "tables", {"derived", "cell", "none"})) {
       spec.tables = static_cast<TruthTables>(*tables);
     }
     spec.perturbation_scale = Number(table, "perturbation_scale", Closed(0, 100, "")).value_or(spec.perturbation_scale);
+    spec.interpolation_scale = Number(table, "interpolation_scale", Closed(0, 100, "")).value_or(spec.interpolation_scale);
     if (std::optional<int> outside = Choice(table, "outside", {"field", "fade", "clamp"})) {
       spec.outside = static_cast<TruthOutside>(*outside);
     }

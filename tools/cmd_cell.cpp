@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "backend/reports/table_report.h"
 #include "base/json_text.h"
 #include "calibration/fixture_geometry.h"
 #include "frontend/cell_toml.h"
@@ -59,6 +60,7 @@ std::string SummaryText(const cell::Cell& cell) {
                        region.name, Range(region.x_mm), Range(region.y_mm), region.table_path, Num(region.domain.x0),
                        Num(region.domain.x1), Num(region.domain.y0), Num(region.domain.y1), region.difficulty_level,
                        Axes(region), Num(region.tolerance_mm), cell::OutsidePolicyName(region.outside));
+    out += fmt::format("    between the nodes: {}\n", InterpolationText(region.interpolation, region.tolerance_mm));
   }
 
   out += fmt::format("fixtures: {}\n", cell.fixtures.size());
@@ -123,7 +125,8 @@ std::string SummaryJson(const cell::Cell& cell) {
                      {"y_mm", Pair(region.domain.y0, region.domain.y1)}}},
          {"difficulty", {{"level", region.difficulty_level}, {"axes", axes}}},
          {"tolerance_mm", region.tolerance_mm},
-         {"outside", cell::OutsidePolicyName(region.outside)}});
+         {"outside", cell::OutsidePolicyName(region.outside)},
+         {"interpolation", InterpolationJson(region.interpolation, region.tolerance_mm)}});
   }
   out["fixtures"] = ordered_json::array();
   for (const cell::Fixture& fixture : cell.fixtures) {
@@ -165,7 +168,11 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
     options.exit_code = ReportIoError(loaded.error());
     return;
   }
-  if (loaded.value()) cell::CheckScanCalibration(*loaded.value(), diags);
+  if (loaded.value()) {
+    cell::CheckScanCalibration(*loaded.value(), diags);
+    cell::ReportTableWarnings(*loaded.value(), diags);
+    cell::ReportGridAdvice(*loaded.value(), diags);
+  }
   options.exit_code = PrintDiagnostics(diags, options);
   if (!loaded.value()) return;  // the errors were printed
   const cell::Cell& cell = *loaded.value();
@@ -183,7 +190,9 @@ void AddCellCommand(CLI::App& app, GlobalOptions& options) {
   cell->require_subcommand(1);
   CLI::App* check = cell->add_subcommand(
       "check", "Load a cell file and its error tables, report every mistake (exit 1), and print a summary:\n"
-               "the robot, each region (bounds, table domain, difficulty, tolerance, policy), each fixture\n"
+               "the robot, each region (bounds, table domain, difficulty, tolerance, policy, the interpolation\n"
+               "error between its table's nodes and the pitch to measure at when it is more than 10 % of the\n"
+               "tolerance), each fixture\n"
                "(pose, L1/L2, scan trips, estimator, teach scan) and each feeder");
   check->add_option("CELL", path,
                     "the cell file ('-' for stdin; its table paths are then relative to the current directory)")

@@ -9,6 +9,7 @@
 #include "backend/reports/table_report.h"
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 #include "calibration/limits.h"
 #include "frontend/table_csv.h"
@@ -26,9 +27,22 @@ struct TableOptions {
   std::string outside = "error";
   std::string solver = "default";
   double paper_tolerance_mm = kPaperSolverTolMm;
+  double tolerance_mm = kDefaultTableToleranceMm;  // check, stats: what the interpolation error is a share of
 };
 
 std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// The interpolation estimate of a table on its own: no cell, so no declared
+// roughness; a node or check point that states no noise counts as one
+// reading with the largest stddev the table states (0 when it states none).
+InterpolationEstimate TableInterpolation(const ErrorTable& table) {
+  double largest = 0;
+  for (const AxisTable& t : table.axes) {
+    for (const auto& sd : t.stddev_mm) largest = std::max(largest, sd.value_or(0.0));
+    for (const TableNode& check : t.checks) largest = std::max(largest, check.stddev_mm.value_or(0.0));
+  }
+  return EstimateInterpolationError(table, std::nullopt, largest);
+}
 
 // Loads and validates a table. Returns nullopt after setting the exit code
 // (I/O error, or input errors printed); diagnostics are printed by the caller
@@ -100,9 +114,13 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
 void RunCheck(const TableOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  if (LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
-    options.exit_code = PrintDiagnostics(diags, options);
-  }
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kReport, options);
+  if (!table) return;
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
+  ReportCoarseGrid(interpolation, opt.tolerance_mm, "the table", interpolation.Origin(), diags);
+  options.exit_code = PrintDiagnostics(diags, options);
+  const std::string text = fmt::format("between the nodes: {}\n", InterpolationText(interpolation, opt.tolerance_mm));
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
 }
 
 void RunStats(const TableOptions& opt, GlobalOptions& options) {
@@ -114,9 +132,10 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
   table->name = BaseName(table->name);
   TableStats stats = ComputeTableStats(*table);
   int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
   Finish(diags, options, "-",
-         opt.json ? FormatStatsJson(*table, stats, analysis, bound)
-                  : FormatStatsText(*table, stats, analysis, bound));
+         opt.json ? FormatStatsJson(*table, stats, analysis, bound, interpolation, opt.tolerance_mm)
+                  : FormatStatsText(*table, stats, analysis, bound, interpolation, opt.tolerance_mm));
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
@@ -177,6 +196,15 @@ void RunPlot(const TableOptions& opt, GlobalOptions& options) {
   Finish(diags, options, opt.output, PlotTableSvg(*table, BaseName(table->name)));
 }
 
+void AddToleranceOption(CLI::App& command, TableOptions& opt) {
+  command
+      .add_option("--tolerance", opt.tolerance_mm,
+                  "the placing tolerance (mm) the interpolation error between the nodes is a share of; above "
+                  "10 % the pitch to measure at next is advised")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void AddTableCommand(CLI::App& app, GlobalOptions& options) {
@@ -186,7 +214,8 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   table->require_subcommand(1);
 
   CLI::App* build = table->add_subcommand(
-      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm) into an error table;\n"
+      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm[,kind]) into an error table\n"
+               "(kind check: check points off the nodes, averaged per position and kept in the table);\n"
                "warns about nodes whose scatter or set-to-set difference is far above the rest");
   build->add_option("RAW", opt.input, "the raw measurement CSV ('-' for stdin)")->required();
   build->add_option("-o,--output", opt.output, "the error table to write ('-' for stdout)")->required();
@@ -194,15 +223,20 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
 
   CLI::App* check = table->add_subcommand(
       "check", "Validate an error table: grid, values, no fold (det(I + grad Delta) >= 0.5), slopes,\n"
-               "and warn where the error changes sign between nodes or exceeds half the pitch");
+               "and warn where the error changes sign between nodes or exceeds half the pitch; print the\n"
+               "interpolation error between the nodes as a share of --tolerance (and the pitch to measure at\n"
+               "when it is more than 10 %)");
   check->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  AddToleranceOption(*check, opt);
   check->callback([&options] { RunCheck(opt, options); });
 
   CLI::App* stats = table->add_subcommand(
       "stats", "The paper's statistics per axis (max, min, mean, origin shift by the means, max |Delta - mean|,\n"
-               "stddev summary) and the inverse calibration's contraction factor and iteration bound");
+               "stddev summary), the inverse calibration's contraction factor and iteration bound, and the\n"
+               "interpolation error between the nodes as a share of --tolerance");
   stats->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
   stats->add_flag("--json", opt.json, "print JSON instead of text");
+  AddToleranceOption(*stats, opt);
   stats->callback([&options] { RunStats(opt, options); });
 
   for (bool inverse : {false, true}) {
