@@ -108,11 +108,11 @@ inline constexpr long kMaxPanelBoards = 10'000;
 // simulate's true error field outside the tables is scaled to its largest
 // magnitude over the robot's reach, sampled every correlation length / 8 in
 // x and y: at most this many samples (a 400 x 300 mm reach at the default
-// 25 mm is 12 000; 4 million take about a second).
+// 25 mm is 12 000; 3 million took 1.6 s, docs/simulate.md).
 inline constexpr double kTrueFieldStepsPerCorrelation = 8;
 inline constexpr double kMaxTrueFieldSamples = 4e6;
 // simulate: the placements of a run, cycles x placements per cycle (each is
-// simulated in six modes): 10 million take about ten seconds.
+// simulated in six modes): 10 million take about a minute (docs/simulate.md).
 inline constexpr long kMaxSimulatedPlacements = 10'000'000;
 // import: the placements of a program (parts x boards of the panel), as the
 // compile-time run follows (passes/correction/target_trace.h).
