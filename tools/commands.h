@@ -2,6 +2,7 @@
 // registers itself on the CLI11 app; the work itself is in the core library.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,6 +11,7 @@
 
 #include "base/diagnostics.h"
 #include "base/result.h"
+#include "calibration/cell.h"
 
 namespace smtcal::tools {
 
@@ -54,5 +56,15 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options);
 void AddCellCommand(CLI::App& app, GlobalOptions& options);
 void AddDiffCommand(CLI::App& app, GlobalOptions& options);
 void AddSimulateCommand(CLI::App& app, GlobalOptions& options);
+// `smtcal measure plan|program|read` (cmd_measure*.cpp): the family, and each command.
+void AddMeasureCommand(CLI::App& app, GlobalOptions& options);
+void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options);
+void AddMeasureProgramCommand(CLI::App& measure, GlobalOptions& options);
+void AddMeasureReadCommand(CLI::App& measure, GlobalOptions& options);
+// The cell of a measurement: tables may be missing; it needs [measure] and
+// robot.final_approach_mm. False (diagnostics printed, exit code set) when
+// it cannot be used.
+bool LoadCellForMeasure(const std::string& path, SourceManager& sources, Diagnostics& diags, GlobalOptions& options,
+                        std::optional<cell::Cell>& cell);
 
 }  // namespace smtcal::tools

@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
   AddCellCommand(app, options);
   AddDiffCommand(app, options);
   AddSimulateCommand(app, options);
+  AddMeasureCommand(app, options);
   int exit_code = kExitOk;
   try {
     exit_code = Run(app, argc, argv, options);

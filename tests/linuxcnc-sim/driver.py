@@ -24,6 +24,8 @@
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
 #   messages every operator message (an abort is one).
+# With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
+# every vacuum change also records where the robot really is ("real").
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
 import os
@@ -41,6 +43,10 @@ RELEASE_OUT = 14    # layers.place: On 14 releases the board (transport)
 def hal(commands):
     """Runs halcmd commands (one per line) in one halcmd process."""
     subprocess.run(["halcmd", "-f"], input="\n".join(commands) + "\n", text=True, check=True)
+
+
+def getp(name):
+    return float(subprocess.run(["halcmd", "getp", name], capture_output=True, text=True, check=True).stdout)
 
 
 def place_board(pose, sensor_models):
@@ -66,6 +72,7 @@ def place_board(pose, sensor_models):
 
 def main():
     plan = json.load(open(os.environ["SMTCAL_SIM_PLAN"]))
+    real_pins = os.environ.get("SMTCAL_SIM_REAL_PINS", "")  # the robot model's component, when there is one
     out_path = os.environ["SMTCAL_SIM_RUN"]
     started = time.monotonic()
     record = {"cycles": [], "messages": [], "vacuum": [], "end": None, "times": {}}
@@ -148,6 +155,10 @@ def main():
             if out == VACUUM_OUT:
                 event = {"t": now(), "on": bool(stat.dout[out]), "position": list(stat.position[:6]),
                          "velocity": stat.current_vel, "cycle": len(record["cycles"]) - 1}
+                if real_pins:
+                    # Where the simulated robot really is (run_measure.py's
+                    # robot model; x and y do not change while z moves).
+                    event["real"] = [getp(real_pins + ".x-real"), getp(real_pins + ".y-real")]
                 record["vacuum"].append(event)
             elif stat.dout[out] and clamped:
                 # The program released the board: this cycle is done.

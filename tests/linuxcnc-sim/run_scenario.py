@@ -135,8 +135,11 @@ def check_prerequisites():
 
 # ------------------------------------------------------------------ the machine
 
-def derive_ini(work, program_dir, dry_run):
-    """paper-cell.ini made headless, with the sensor HAL and the program's subroutines."""
+def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("marker-sensor.hal",)):
+    """paper-cell.ini made headless, with the sensor HAL and the program's subroutines.
+    `display`: the DISPLAY program (a file of this folder); `extra_hals`: HAL
+    files loaded after the example's, in order (files of this folder, or
+    paths of files the scenario wrote into `work`)."""
     lines = open(os.path.join(EXAMPLE, "paper-cell.ini")).read().splitlines()
     out, section = [], ""
     for line in lines:
@@ -145,7 +148,7 @@ def derive_ini(work, program_dir, dry_run):
             section = stripped
         key = stripped.split("=", 1)[0].strip() if "=" in stripped and not stripped.startswith("#") else ""
         if section == "[DISPLAY]" and key == "DISPLAY":
-            line = "DISPLAY = " + os.path.join(work, "driver.py")
+            line = "DISPLAY = " + os.path.join(work, display)
         elif section == "[DISPLAY]" and key in ("INTRO_GRAPHIC", "INTRO_TIME"):
             continue  # popimage needs X
         elif section == "[RS274NGC]" and key == "SUBROUTINE_PATH":
@@ -154,18 +157,20 @@ def derive_ini(work, program_dir, dry_run):
                 line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
-            out.append("HALFILE = " + os.path.join(work, "marker-sensor.hal"))
+            for hal in extra_hals:
+                out.append("HALFILE = " + os.path.join(work, os.path.basename(hal)))
     ini = os.path.join(work, "sim.ini")
     # LinuxCNC reads nothing outside the scenario's folder (see work_root).
-    for name in ("driver.py", "marker-sensor.hal"):
-        shutil.copy(os.path.join(HERE, name), work)
+    for name in (display,) + tuple(extra_hals):
+        if os.path.exists(os.path.join(HERE, name)):
+            shutil.copy(os.path.join(HERE, name), work)
     open(ini, "w").write("\n".join(out) + "\n")
     for name in ("paper-cell.hal", "paper-cell.tbl", "paper-cell.var"):
         shutil.copy(os.path.join(EXAMPLE, name), work)
     return ini
 
 
-def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
+def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None):
     tmp = os.path.join(work, "tmp")
     os.makedirs(tmp, exist_ok=True)
     os.chmod(tmp, 0o1777)  # rtapi_app binds its socket as RTAPI_UID
@@ -173,6 +178,7 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
     os.makedirs(home, exist_ok=True)
     env = dict(os.environ, RTAPI_UID="65534", RTAPI_FIFO_PATH="/tmp/rtapi_fifo", HOME=home,
                SMTCAL_SIM_PLAN=plan_path, SMTCAL_SIM_RUN=run_path)
+    env.update(extra_env or {})
     env.pop("DISPLAY", None)  # no X
     # Inside: a private /tmp (LinuxCNC's lock file and temporaries), then LinuxCNC.
     inner = 'mount --bind "$0" /tmp && cd "$1" && exec linuxcnc -r "$2"'
