@@ -171,8 +171,12 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
   return nodes;
 }
 
-std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& measurements,
+std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& all,
                                           SourceLoc file, Diagnostics& diags) {
+  std::vector<RawMeasurement> measurements;
+  for (const RawMeasurement& m : all) {
+    if (!m.check) measurements.push_back(m);
+  }
   std::size_t errors_before = diags.error_count();
   std::vector<NodeSummary> summaries = SummarizeNodes(measurements, diags);
   if (diags.error_count() != errors_before) return std::nullopt;

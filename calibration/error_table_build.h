@@ -22,6 +22,7 @@ struct RawMeasurement {
   long long set = 0;
   long long repetition = 0;
   double error_mm = 0;
+  bool check = false;   // kind = check: a check point between nodes, not a node of the table
   SourceRange x_field;  // for "node ... is here"
   SourceRange y_field;
   SourceRange repetition_field;
@@ -49,6 +50,7 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
 
 // The whole build: summaries, warnings for noisy nodes and set shifts, and
 // the table assembled from the node means (AssembleErrorTable's checks).
+// Check-point readings (kind = check) are not nodes and are left out.
 // Validation (ValidateErrorTable) is the caller's next step. nullopt on errors.
 std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& measurements,
                                           SourceLoc file, Diagnostics& diags);

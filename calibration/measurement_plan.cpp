@@ -2,6 +2,7 @@
 #include "calibration/measurement_plan.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -343,11 +344,24 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
           region.name, Mm(region.pitch_mm), Mm(m.probe.hole_pitch_mm), Mm(2 * m.probe.hole_pitch_mm)));
     }
     // Never coarser than the region: at least two lines each way.
-    region.xs = GridLines(region.x_mm, region.margin_mm, region.pitch_mm, robot.limits[0]);
-    region.ys = GridLines(region.y_mm, region.margin_mm, region.pitch_mm, robot.limits[1]);
+    // Where nodes may lie: the approach point (node - approach) and the
+    // probe's moves (towards the wall, in the approach's direction) stay
+    // within the robot's range too.
+    std::array<cell::Interval, 2> usable;
+    for (int axis = 0; axis < 2; ++axis) {
+      const double a = plan.approach_mm[axis];
+      const double reach = m.device == cell::MeasureDevice::kProbe
+                               ? ProbeContactRadiusMm(m.probe) + m.probe.overtravel_mm
+                               : 0.0;
+      const cell::Interval& limit = robot.limits[static_cast<std::size_t>(axis)];
+      usable[static_cast<std::size_t>(axis)] = {limit.lo + std::max(a, 0.0) + (a < 0 ? reach : 0.0),
+                                                limit.hi + std::min(a, 0.0) - (a > 0 ? reach : 0.0)};
+    }
+    region.xs = GridLines(region.x_mm, region.margin_mm, region.pitch_mm, usable[0]);
+    region.ys = GridLines(region.y_mm, region.margin_mm, region.pitch_mm, usable[1]);
     for (int axis = 0; axis < 2; ++axis) {
       const std::vector<double>& lines = axis == 0 ? region.xs : region.ys;
-      const cell::Interval& limit = robot.limits[static_cast<std::size_t>(axis)];
+      const cell::Interval& limit = usable[static_cast<std::size_t>(axis)];
       if (lines.front() < limit.lo || lines.back() > limit.hi) {
         diags.Report(DiagKind::MeasureGridOutsideRobot, source != nullptr ? source->bounds_range : cell_file,
                      region.name, axis == 0 ? "x" : "y", Mm(lines.front()), Mm(lines.back()), Mm(region.margin_mm),

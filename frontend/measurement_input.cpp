@@ -75,7 +75,23 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
         region.y_mm = known->y_mm;
         region.tolerance_mm = known->tolerance_mm;
       } else {
+        // Not in the cell: one the plan proposed under a fixture's markers
+        // (FIXTURE_PATH), or a plan of another cell.
         region.proposed = true;
+        std::vector<std::string> names;
+        bool marker = false;
+        for (const cell::Region& r : cell.regions) names.push_back(r.name);
+        for (const cell::Fixture& fixture : cell.fixtures) {
+          for (const cell::ScanPath& path : fixture.scan_paths) {
+            marker = marker || AsciiLowercase(fixture.name + "_" + path.name) == AsciiLowercase(row.region);
+          }
+        }
+        if (!marker) {
+          std::string closest = ClosestName(row.region, names);
+          diags.Report(DiagKind::MeasurePlanRegion, row.region_field, Printable(row.region), cell.name,
+                       closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
+          return std::nullopt;
+        }
       }
       plan.regions.push_back(region);
     }
@@ -126,17 +142,18 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
     if (line.starts_with(kLogMark)) {
       LogBlock block;
       block.header = std::string(line.substr(2));
-      block.digest = Item(line, "digest");
+      // "...: plan NAME digest HEX; ...; visits F..L"
+      const std::size_t digest_at = line.find(" digest ");
+      if (digest_at != std::string_view::npos) {
+        std::string_view rest = line.substr(digest_at + 8);
+        block.digest = std::string(rest.substr(0, rest.find(';')));
+      }
       std::string range = Item(line, "visits");
       std::size_t dots = range.find("..");
       if (dots != std::string::npos) {
         block.first_visit = std::atoi(range.substr(0, dots).c_str());
         block.last_visit = std::atoi(range.substr(dots + 2).c_str());
       }
-      // "plan NAME digest HEX": the digest is the second word of the plan item.
-      std::string plan_item = Item(line, "plan");
-      std::size_t digest_at = plan_item.rfind(" digest ");
-      if (digest_at != std::string::npos) block.digest = plan_item.substr(digest_at + 8);
       if (block.digest != plan.digest) {
         diags.Report(DiagKind::MeasureLogOtherPlan, where, block.digest.empty() ? "(none)" : block.digest, plan.digest,
                      Printable(plan.name));

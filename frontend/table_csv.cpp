@@ -34,8 +34,11 @@ struct Schema {
 
 const Schema kTableSchema{
     "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
-const Schema kRawSchema{
-    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
+const Schema kRawSchema{"a raw measurement file",
+                        "measurement",
+                        {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm", "kind"},
+                        6,
+                        false};
 const Schema kPointSchema{"a point list", "point", {"x_mm", "y_mm"}, 2, true};
 const Schema kPlanSchema{"a measurement plan", "visit",
                          {"visit", "region", "axes", "station", "kind", "node", "x_mm", "y_mm", "set", "repetitions"},
@@ -396,12 +399,15 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
 }
 
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kSet, kRepetition, kError };
+  enum { kAxis, kX, kY, kSet, kRepetition, kError, kKind };
   auto read_row = [](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
     std::optional<TableAxis> axis = row.Axis(kAxis);
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
     std::optional<double> error = row.Number(kError);
+    // kind: node (or empty, or no column) or check (a check point between nodes).
+    std::optional<std::size_t> kind;
+    if (row.Field(kKind) != nullptr && !row.Field(kKind)->text.empty()) kind = row.Choice(kKind, {"node", "check"});
     if (!row.ok) return std::nullopt;
     RawMeasurement m;
     m.axis = *axis;
@@ -410,6 +416,7 @@ std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t fil
     m.set = *set;
     m.repetition = *repetition;
     m.error_mm = *error;
+    m.check = kind.value_or(0) == 1;
     m.x_field = row.Range(kX);
     m.y_field = row.Range(kY);
     m.repetition_field = row.Range(kRepetition);

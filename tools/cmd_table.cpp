@@ -2,6 +2,7 @@
 // a calibrated region (docs/error-tables.md). The work is in
 // frontend/table_csv, passes/error_table*, passes/inverse_calibration and
 // backend/table_*; this file only wires files, options and exit codes.
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 
@@ -90,6 +91,10 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
     text = FormatTableCsv(*table, BuiltTableComment(BaseName(opt.input)));
   }
   Finish(diags, options, opt.output, text);
+  const long checks = raw ? std::count_if(raw->begin(), raw->end(), [](const RawMeasurement& m) { return m.check; }) : 0;
+  if (checks > 0 && options.exit_code == kExitOk && !options.quiet) {
+    fmt::print(stderr, "smtcal: {} readings at check points (kind = check) are not nodes of the table\n", checks);
+  }
 }
 
 void RunCheck(const TableOptions& opt, GlobalOptions& options) {

@@ -44,6 +44,7 @@ from run_scenario import (check_prerequisites, derive_ini, fail, leftover_proces
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 LOOP_PROGRAM = os.path.join(HERE, "measure-loop.place")
+RTLIB_DIR = "/usr/lib/linuxcnc/modules"
 SCRATCH_CELL = os.path.join(os.path.dirname(os.path.dirname(HERE)), "examples", "calibrating", "scratch.cell.toml")
 APPROACH = (0.5, 0.5)
 
@@ -139,10 +140,14 @@ def scenario_cell(work, device, ready_input=False):
 
 def robot_hal(work, model_so, device, ready_wired):
     """The robot model and the device in HAL, after paper-cell.hal."""
-    so = os.path.join(work, "smtcal_robot_model.so")
-    shutil.copy(model_so, so)
+    # rtapi_app loads modules from /usr/lib/linuxcnc/modules only: LinuxCNC's
+    # and the model, in a copy bound over it in the run's mount namespace.
+    modules = os.path.join(work, "modules")
+    if not os.path.isdir(modules):
+        shutil.copytree(RTLIB_DIR, modules)
+    shutil.copy(model_so, modules)
     lines = ["# robot-model.hal - written by run_measure.py: the modelled robot and its measuring device",
-             f"loadrt {so[:-3]}",
+             "loadrt smtcal_robot_model",
              "addf smtcal-robot-model.0 servo-thread",
              "net x-pos => smtcal-robot-model.0.x-cmd",
              "net y-pos => smtcal-robot-model.0.y-cmd",
@@ -247,7 +252,7 @@ def measure_on_controller(args, work, cell, device, plan_csv, start=1, fault=Non
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, f"{run_name}.json")
     began = time.monotonic()
-    code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
+    code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"], modules=os.path.join(work, "modules"))
     machine_s = time.monotonic() - began
     left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
     if left:
@@ -343,7 +348,7 @@ def loop(args, work, cell, scenario):
     run_path = os.path.join(work, "loop-run.json")
     began = time.monotonic()
     start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"],
-                   extra_env={"SMTCAL_SIM_REAL_PINS": "smtcal-robot-model.0"})
+                   extra_env={"SMTCAL_SIM_REAL_PINS": "smtcal-robot-model.0"}, modules=os.path.join(work, "modules"))
     if not os.path.exists(run_path):
         fail("LinuxCNC ended without the driver's record:\n" + open(os.path.join(work, "linuxcnc.log")).read()[-3000:])
     record = json.load(open(run_path))
@@ -415,7 +420,7 @@ def main():
             fail(f"the {fault} fault did not stop the measurement")
         text = aborts[0]
         m = re.search(r"smtcal: measuring stopped at visit (\d+) - ", text)
-        want = {"ready": "the device's ready input did not come on", "no_contact": "the probe did not touch"}[fault]
+        want = {"ready": "the device's ready input stayed off", "no_contact": "the probe did not touch"}[fault]
         if not m or want not in text or f"--start {m.group(1)}" not in text:
             fail(f"the {fault} fault's abort does not say what and where to resume: {text!r}")
         log(f"  {fault}: {text}")

@@ -162,7 +162,7 @@ def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("mar
     ini = os.path.join(work, "sim.ini")
     # LinuxCNC reads nothing outside the scenario's folder (see work_root).
     for name in (display,) + tuple(extra_hals):
-        if os.path.exists(os.path.join(HERE, name)):
+        if not os.path.isabs(name) and os.path.exists(os.path.join(HERE, name)):
             shutil.copy(os.path.join(HERE, name), work)
     open(ini, "w").write("\n".join(out) + "\n")
     for name in ("paper-cell.hal", "paper-cell.tbl", "paper-cell.var"):
@@ -170,7 +170,7 @@ def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("mar
     return ini
 
 
-def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None):
+def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None, modules=None):
     tmp = os.path.join(work, "tmp")
     os.makedirs(tmp, exist_ok=True)
     os.chmod(tmp, 0o1777)  # rtapi_app binds its socket as RTAPI_UID
@@ -181,9 +181,13 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None):
     env.update(extra_env or {})
     env.pop("DISPLAY", None)  # no X
     # Inside: a private /tmp (LinuxCNC's lock file and temporaries), then LinuxCNC.
+    # `modules`: a folder of realtime modules seen as LinuxCNC's own
+    # (rtapi_app loads only from /usr/lib/linuxcnc/modules), in this run only.
     inner = 'mount --bind "$0" /tmp && cd "$1" && exec linuxcnc -r "$2"'
+    if modules:
+        inner = 'mount --bind "$3" /usr/lib/linuxcnc/modules && ' + inner
     argv = ["timeout", "-k", "10", str(timeout_s + 60), "unshare", "--pid", "--fork", "--kill-child",
-            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini]
+            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini, modules or ""]
     with open(os.path.join(work, "linuxcnc.log"), "w") as log_file:
         return subprocess.run(argv, env=env, stdout=log_file, stderr=subprocess.STDOUT).returncode
 

@@ -92,7 +92,7 @@ TEST(LinuxCncMeasure, ProbeProgramApproachesEveryNodeAndAbortsWithoutContact) {
   test::Rs274Result run = RunProgram(dir / "out", "measure_layer1.ngc");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("smtcal: measuring stopped at visit 1 - node 1 set 1 repetition 1: the probe did not "
-                         "touch the hole's wall along x"),
+                         "touch the wall along x"),
             std::string::npos)
       << run.err;
   EXPECT_NE(run.err.find("smtcal measure program --start 1"), std::string::npos) << run.err;
