@@ -61,7 +61,8 @@ std::vector<ReadingError> ErrorsOfReadings(const cell::Measure& measure, const c
                                            const std::vector<double>& xs, const std::vector<double>& ys,
                                            const std::vector<Reading>& readings, std::vector<std::string>& notes);
 
-// The plan file's digest (FNV-1a 64 of its bytes, 16 hex digits): the
+// The plan file's digest (a 64-bit FNV-1a hash of its bytes with the
+// project's constants, 16 hex digits): the
 // measuring program writes it into its log, and `measure read` refuses a log
 // of another plan.
 std::string PlanDigest(std::string_view text);

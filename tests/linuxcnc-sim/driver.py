@@ -25,7 +25,8 @@
 #            next move, the rise in z, begins);
 #   messages every operator message (an abort is one).
 # With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
-# every vacuum change also records where the robot really is ("real").
+# every Place also records where the robot really was ("real": the model's
+# position latched in the servo thread when the valve went off).
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
 import os
@@ -43,10 +44,6 @@ RELEASE_OUT = 14    # layers.place: On 14 releases the board (transport)
 def hal(commands):
     """Runs halcmd commands (one per line) in one halcmd process."""
     subprocess.run(["halcmd", "-f"], input="\n".join(commands) + "\n", text=True, check=True)
-
-
-def getp(name):
-    return float(subprocess.run(["halcmd", "getp", name], capture_output=True, text=True, check=True).stdout)
 
 
 def place_board(pose, sensor_models):
@@ -96,6 +93,15 @@ def main():
         os.replace(out_path + ".tmp", out_path)
 
     stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+    reader = None
+    if real_pins:
+        import hal as hal_module
+        reader = hal_module.component("smtcal-sim-reader")
+        reader.newpin("x", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.newpin("y", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.ready()
+        hal([f"net placed-x {real_pins}.x-latched => smtcal-sim-reader.x",
+             f"net placed-y {real_pins}.y-latched => smtcal-sim-reader.y"])
 
     def wait_for(predicate, what, timeout_s=30):
         end = time.monotonic() + timeout_s
@@ -155,10 +161,10 @@ def main():
             if out == VACUUM_OUT:
                 event = {"t": now(), "on": bool(stat.dout[out]), "position": list(stat.position[:6]),
                          "velocity": stat.current_vel, "cycle": len(record["cycles"]) - 1}
-                if real_pins:
-                    # Where the simulated robot really is (run_measure.py's
-                    # robot model; x and y do not change while z moves).
-                    event["real"] = [getp(real_pins + ".x-real"), getp(real_pins + ".y-real")]
+                if reader is not None and not event["on"]:
+                    # Where the modelled robot really was when the valve went
+                    # off (latched in the servo thread by run_measure.py's model).
+                    event["real"] = [reader["x"], reader["y"]]
                 record["vacuum"].append(event)
             elif stat.dout[out] and clamped:
                 # The program released the board: this cycle is done.

@@ -335,6 +335,7 @@ def loop(args, work, cell, scenario):
     # the model's real position (the driver's sensor model: the identity).
     hal = robot_hal(work, args.model, "none", False)
     with open(hal, "a") as f:
+        f.write("net vacuum-valve => smtcal-robot-model.0.latch\n")
         for unit in range(4):
             f.write(f"unlinkp sum2.{unit}.in0\nunlinkp sum2.{unit}.in1\n")
             f.write(f"net x-real => sum2.{unit}.in0\nnet y-real => sum2.{unit}.in1\n")

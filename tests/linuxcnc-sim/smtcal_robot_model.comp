@@ -7,6 +7,9 @@ a linear part and four sinusoids per axis; z a tilt) and by backlash (a play
 operator per axis: the nut lags the command by up to half the backlash).
 measure_model.py holds the same model in Python; both must agree.
 
+x-latched, y-latched: the real position when the latch input fell (the
+vacuum valve going off: where a part was placed).
+
 Devices (param device: 0 none, 1 transducer, 2 probe):
 - transducer: the paper's plate with grooves carried by the robot; the
   measuring transducer on a flank reads the compression (contact-z minus the
@@ -25,6 +28,9 @@ pin in float z_cmd;
 pin out float x_real;
 pin out float y_real;
 pin out float z_real;
+pin in bit latch;
+pin out float x_latched;
+pin out float y_latched;
 
 param rw float dx_c;
 param rw float dx_gx;
@@ -72,6 +78,7 @@ variable double nut_y;
 variable int started;
 variable rtapi_u64 rng;
 variable double threshold;
+variable int latch_was;
 
 function _ fp;
 license "GPL";
@@ -129,6 +136,12 @@ FUNCTION(_) {
     x_real = mx + ex;
     y_real = my + ey;
     z_real = z_cmd + dz_c + dz_gx * mx + dz_gy * my;
+    /* Where the robot really was when latch fell (the vacuum valve off: a Place). */
+    if (latch_was && !latch) {
+        x_latched = x_real;
+        y_latched = y_real;
+    }
+    latch_was = latch;
 
     if (device == 1) {
         double compression = ldt_contact_z - z_real;
