@@ -169,7 +169,9 @@ def robot_hal(work, model_so, device, ready_wired):
                   "setp smtcal-robot-model.0.ldt-pitch 5",
                   "setp smtcal-robot-model.0.ldt-slope 1",
                   "setp smtcal-robot-model.0.ldt-zero 0",
-                  f"setp smtcal-robot-model.0.ldt-noise {d['noise_mm']!r}",
+                  # Two transducers, each noisy: the error read from their
+                  # difference has the cell's stated noise.
+                  f"setp smtcal-robot-model.0.ldt-noise {d['noise_mm'] / math.sqrt(2)!r}",
                   "net ldt-measure smtcal-robot-model.0.ldt-measure => motion.analog-in-00",
                   "net ldt-reference smtcal-robot-model.0.ldt-reference => motion.analog-in-01"]
     elif device == "external":
