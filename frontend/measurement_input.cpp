@@ -38,6 +38,7 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
   const std::size_t errors_before = diags.error_count();
   LoadedPlan loaded;
   loaded.name = diags.sources().File(file).name;
+  loaded.file = file;
   loaded.digest = PlanDigest(diags.sources().File(file).text);
   Plan& plan = loaded.plan;
   plan.cell_name = cell.name;

@@ -22,6 +22,7 @@ struct LoadedPlan {
   Plan plan;
   std::string digest;  // PlanDigest of the file's text
   std::string name;    // the file's name as given
+  std::uint32_t file = 0;  // its SourceManager id
   std::vector<std::uint32_t> lines;  // per visit: its line in the file
 };
 std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, Diagnostics& diags);

@@ -33,15 +33,10 @@ void RunProgram(const ProgramOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<cell::Cell> cell;
-  if (!LoadCellForMeasure(opt.cell, sources, diags, options, cell)) return;
-  Result<std::uint32_t> file = sources.Load(opt.plan);
-  if (!file) {
-    options.exit_code = ReportIoError(file.error());
-    return;
-  }
-  std::optional<measure::LoadedPlan> plan = measure::LoadPlan(file.value(), *cell, diags);
+  std::optional<measure::LoadedPlan> plan;
+  if (!LoadMeasurePlan(opt.plan, opt.cell, sources, diags, options, cell, plan)) return;
   options.exit_code = PrintDiagnostics(diags, options);
-  if (!plan || options.exit_code != kExitOk) return;
+  if (options.exit_code != kExitOk) return;
   const int visits = static_cast<int>(plan->plan.visits.size());
   if (opt.start > visits) {
     fmt::print(stderr, "smtcal: error: --start {}: the plan has {} visits\n", opt.start, visits);
@@ -95,6 +90,23 @@ bool LoadCellForMeasure(const std::string& path, SourceManager& sources, Diagnos
     return false;
   }
   cell = std::move(loaded.value());
+  return true;
+}
+
+bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path, SourceManager& sources,
+                     Diagnostics& diags, GlobalOptions& options, std::optional<cell::Cell>& cell,
+                     std::optional<measure::LoadedPlan>& plan) {
+  if (!LoadCellForMeasure(cell_path, sources, diags, options, cell)) return false;
+  Result<std::uint32_t> file = sources.Load(plan_path);
+  if (!file) {
+    options.exit_code = ReportIoError(file.error());
+    return false;
+  }
+  plan = measure::LoadPlan(file.value(), *cell, diags);
+  if (!plan) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return false;
+  }
   return true;
 }
 

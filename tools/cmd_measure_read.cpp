@@ -72,17 +72,9 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<cell::Cell> cell;
-  if (!LoadCellForMeasure(opt.cell, sources, diags, options, cell)) return;
-  Result<std::uint32_t> plan_file = sources.Load(opt.plan);
-  if (!plan_file) {
-    options.exit_code = ReportIoError(plan_file.error());
-    return;
-  }
-  std::optional<measure::LoadedPlan> plan = measure::LoadPlan(plan_file.value(), *cell, diags);
-  if (!plan) {
-    options.exit_code = PrintDiagnostics(diags, options);
-    return;
-  }
+  std::optional<measure::LoadedPlan> plan;
+  if (!LoadMeasurePlan(opt.plan, opt.cell, sources, diags, options, cell, plan)) return;
+  const std::uint32_t plan_file = plan->file;
   // The region.
   std::optional<std::size_t> region;
   if (opt.region.empty() && plan->plan.regions.size() == 1) region = 0;
@@ -141,7 +133,7 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
           }
         }
         diags.Report(DiagKind::MeasureLogIncomplete,
-                     SourceRange(SourceLoc{plan_file.value(), plan->lines[k], 1}), visit.number, visit.node, grid.name,
+                     SourceRange(SourceLoc{plan_file, plan->lines[k], 1}), visit.number, visit.node, grid.name,
                      FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set, rep, stopped, BaseName(opt.plan),
                      visit.number);
       }

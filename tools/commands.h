@@ -12,6 +12,7 @@
 #include "base/diagnostics.h"
 #include "base/result.h"
 #include "calibration/cell.h"
+#include "frontend/measurement_input.h"
 
 namespace smtcal::tools {
 
@@ -66,5 +67,10 @@ void AddMeasureReadCommand(CLI::App& measure, GlobalOptions& options);
 // it cannot be used.
 bool LoadCellForMeasure(const std::string& path, SourceManager& sources, Diagnostics& diags, GlobalOptions& options,
                         std::optional<cell::Cell>& cell);
+// ... and the plan made for it (frontend/measurement_input.h); false, with
+// the diagnostics printed and the exit code set, when either cannot be used.
+bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path, SourceManager& sources,
+                     Diagnostics& diags, GlobalOptions& options, std::optional<cell::Cell>& cell,
+                     std::optional<measure::LoadedPlan>& plan);
 
 }  // namespace smtcal::tools
