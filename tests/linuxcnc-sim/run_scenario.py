@@ -230,6 +230,25 @@ f.flush()
 """
 
 
+def run_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs):
+    """Runs LinuxCNC with its driver (start_linuxcnc; kwargs go there) and
+    returns the driver's record and the seconds LinuxCNC ran. Fails when a
+    process of the run outlives it or the driver left no record; skips
+    where LinuxCNC could not start."""
+    began = time.monotonic()
+    code = start_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs)
+    machine_s = time.monotonic() - began
+    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
+    if left:
+        fail("processes of the run outlived it: " + "; ".join(left))
+    if not os.path.exists(run_path):
+        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
+        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
+            skip("LinuxCNC could not start here:\n" + tail)
+        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
+    return json.load(open(run_path)), machine_s
+
+
 def work_root(path):
     """Where the scenarios run. LinuxCNC runs with a private /tmp bound over
     the system's, which hides everything below /tmp: a build under /tmp (a
@@ -386,18 +405,7 @@ def main():
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
-    machine_started = time.monotonic()
-    code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
-    machine_s = time.monotonic() - machine_started
-    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
-    if left:
-        fail("processes of the run outlived it: " + "; ".join(left))
-    if not os.path.exists(run_path):
-        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
-        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
-            skip("LinuxCNC could not start here:\n" + tail)
-        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
-    record = json.load(open(run_path))
+    record, machine_s = run_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
     log(f"scenario {args.scenario}: {os.path.basename(scenario['program'])}, {len(record['cycles'])} cycle(s), "
         f"LinuxCNC ran {machine_s:.1f} s (ready after {record['times'].get('ready_s', 0):.1f} s), "
         f"run ended: {record['end']}")

@@ -17,10 +17,10 @@ const char* kPlan =
     "3,layer1,xy,1,check,5,160,70,1,2\n"
     "4,layer1,xy,1,node,4,170,80,1,2\n"
     "5,layer1,xy,1,node,3,150,80,1,2\n"
-    "6,feeders,xy,1,node,6,155,5,1,2\n"
-    "7,feeders,xy,1,node,7,175,5,1,2\n"
-    "8,feeders,xy,1,node,8,155,30,1,2\n"
-    "9,feeders,xy,1,node,9,175,30,1,2\n";
+    "6,Board_v1,xy,1,node,6,155,5,1,2\n"
+    "7,Board_v1,xy,1,node,7,175,5,1,2\n"
+    "8,Board_v1,xy,1,node,8,155,30,1,2\n"
+    "9,Board_v1,xy,1,node,9,175,30,1,2\n";
 
 cell::Cell ProbeCell() {
   cell::Cell c;
@@ -33,6 +33,14 @@ cell::Cell ProbeCell() {
   layer1.name = "layer1";
   layer1.tolerance_mm = 0.1;
   c.regions.push_back(layer1);
+  // The plan's second region is one it proposed under this fixture's
+  // markers (FIXTURE_PATH), not a region of the cell.
+  cell::Fixture board;
+  board.name = "Board";
+  cell::ScanPath v1;
+  v1.name = "v1";
+  board.scan_paths.push_back(v1);
+  c.fixtures.push_back(board);
   return c;
 }
 
@@ -51,7 +59,7 @@ TEST(MeasurementPlanFile, ReadsRegionsGridsAndVisits) {
   EXPECT_EQ(layer1.xs, (std::vector<double>{150, 170}));  // the check point is no grid line
   EXPECT_EQ(layer1.ys, (std::vector<double>{60, 80}));
   EXPECT_FALSE(layer1.proposed);
-  EXPECT_TRUE(plan->plan.regions[1].proposed);  // the test cell has no feeders region
+  EXPECT_TRUE(plan->plan.regions[1].proposed);  // under the markers, not in the cell
   EXPECT_EQ(plan->plan.visits.size(), 9u);
   EXPECT_EQ(plan->plan.visits[2].kind, VisitKind::kCheck);
   EXPECT_EQ(plan->digest, PlanDigest(kPlan));
@@ -68,7 +76,7 @@ TEST(MeasurementPlanFile, RefusesVisitsOutOfOrderAMovedNodeAndAnotherDevice) {
   {
     Files f;
     std::string text = kPlan;
-    text.replace(text.find("7,feeders,xy,1,node,7"), 21, "7,feeders,xy,1,node,6");
+    text.replace(text.find("7,Board_v1,xy,1,node,7"), 22, "7,Board_v1,xy,1,node,6");
     EXPECT_FALSE(LoadPlan(f.Add("plan.csv", text), ProbeCell(), f.diags));
     EXPECT_NE(f.diags.RenderText().find("a node is one point"), std::string::npos) << f.diags.RenderText();
   }
