@@ -74,6 +74,13 @@ struct Robot {
   // its leg (LinuxCNC's servo thread: 1 ms).
   double servo_period_s = 0.001;
   SourceRange servo_period_range;  // its key (the [robot] table when absent)
+  // The final approach: every calibrated target is reached by a last straight
+  // x-y move of this vector, from target - approach to the target, so each
+  // axis's backlash is taken up the same way at every target as at every
+  // node of the measurement (docs/measure.md, "Backlash"). Unset: targets are
+  // reached straight, and `smtcal measure plan` asks for it.
+  std::optional<Eigen::Vector2d> final_approach_mm;
+  SourceRange final_approach_range;  // its key (the [robot] table when absent)
   SourceRange range;        // the [robot] table
 };
 
@@ -108,7 +115,12 @@ struct Region {
   SourceRange difficulty_range;
   std::string table_path;  // as written, relative to the cell file
   SourceRange table_range;
-  ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
+  // Loaded and validated (ValidateErrorTable passed). Only a cell loaded for
+  // planning a measurement (CellLoadOptions) may have a region without a
+  // table yet: then has_table is false, the table and domain are empty, and
+  // the bounds are as written.
+  bool has_table = true;
+  ErrorTable table;
   Rect domain;             // TableDomain(table): where F is defined
   // How far the robot's error may depart from the table's interpolation
   // between its nodes: RegionInterpolation(robot, table), set by the loader.
@@ -230,9 +242,74 @@ struct LinuxCnc {
   SourceRange range;             // the [linuxcnc] table
 };
 
+// [measure]: the instrument that measures the robot's error at the nodes of
+// a region (docs/measure.md, docs/cell.md). One of three devices:
+enum class MeasureDevice {
+  // The paper's (Fig. 4): a linear displacement transducer touches the flank
+  // of a groove in a precise plate the robot carries; the flank turns the
+  // robot's error along the axis into a vertical displacement, read as an
+  // analog input, and a second transducer on the plate's surface takes out
+  // the robot's z error. One axis per run (the transducer is mounted for it).
+  kTransducer,
+  // A touch probe in the gripper against a precise hole at every node (a
+  // hole plate): the probe moves from the node towards the hole's wall along
+  // each axis; the trip against the wall's calibrated position is the error.
+  kProbe,
+  // An external system (camera, CMM, laser tracker): the program triggers it
+  // at every node and waits for it; its readings come as CSV keyed by node.
+  kExternal,
+};
+inline constexpr std::array<std::string_view, 3> kMeasureDeviceNames = {"transducer", "probe", "external"};
+
+struct MeasureTransducer {
+  int input = 0;            // motion.analog-in-NN of the measuring transducer (on the groove's flank)
+  int reference_input = 1;  // motion.analog-in-NN of the z reference transducer (on the plate's surface)
+  // The reading's change per mm of the robot's error along the measured axis
+  // (the flank's slope, signed: 1 for a 45 degree flank rising with the axis).
+  double slope = 1;
+  // The measuring minus the reference reading with the robot exactly at the
+  // node (from the set-up: the plate's certificate and the zeroing gauge).
+  double zero_mm = 0;
+  Interval range_mm{0, 1};  // readings outside it: the transducer lost contact (the program aborts)
+  double groove_pitch_mm = 5;  // nodes and check points must lie on grooves: multiples of it from the first node
+  int grooves = 11;            // grooves per direction: the plate's reach
+};
+
+struct MeasureProbe {
+  double hole_diameter_mm = 0;    // the holes' calibrated diameter
+  double hole_pitch_mm = 5;       // the holes sit on a square lattice of this pitch; nodes and check points must be holes
+  double stylus_diameter_mm = 0;  // the stylus ball's effective diameter (calibrated on a ring gauge)
+  double speed_mm_s = 1;          // the probing feed
+  double overtravel_mm = 0.5;     // how far past the expected wall a probe move may go before it is a miss
+};
+
+struct MeasureExternal {
+  int trigger_output = 0;  // motion.digital-out-NN: on asks the system for a reading
+  int done_input = 0;      // motion.digital-in-NN: on when the system has taken it
+  int node_output = 0;     // motion.analog-out-NN: the node; the set and repetition on the next two
+};
+
+struct Measure {
+  MeasureDevice device = MeasureDevice::kProbe;
+  SourceRange device_range;
+  double z_mm = 0;        // the robot z at which the device reads
+  double clear_z_mm = 0;  // the z between nodes (default: the robot's safe_limz_mm)
+  double dwell_s = 0.2;   // settle time at the node before the reading
+  double noise_mm = 0;    // one standard deviation of a single reading (the device's stated noise)
+  double timeout_s = 5;   // how long the program waits for the device before it aborts
+  double reading_time_s = 0;  // the device's own time per reading (an external system's exposure), for the plan's time
+  std::optional<int> ready_input;  // motion.digital-in-NN, on while the device is ready (checked before each reading)
+  MeasureTransducer transducer;
+  MeasureProbe probe;
+  MeasureExternal external;
+  SourceRange range;  // the [measure] table
+};
+
 // LinuxCNC's motion controller has at most 64 digital inputs and outputs
 // (motion.digital-in/out-00..63, [EMCMOT]num_dio).
 inline constexpr int kLinuxCncMaxDio = 64;
+// ... and at most 64 analog inputs and outputs (motion.analog-in/out-NN, [EMCMOT]num_aio).
+inline constexpr int kLinuxCncMaxAio = 64;
 
 struct Cell {
   std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
@@ -243,6 +320,7 @@ struct Cell {
   std::vector<Fixture> fixtures;
   std::vector<Feeder> feeders;
   std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
+  std::optional<Measure> measure;    // the [measure] table, when the file has one
 
   const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
   const Region* FindRegion(std::string_view name) const;    // case-insensitive

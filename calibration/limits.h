@@ -78,6 +78,13 @@ inline constexpr NumberRange kDifficultyLevel = Whole(1, 4);
 // An input or output bit of the robot controller; a LinuxCNC digital input.
 inline constexpr NumberRange kIoBit = Whole(kIoBitMin, kIoBitMax);
 inline constexpr NumberRange kLinuxCncInput = Whole(0, 63);  // [EMCMOT] num_dio: 64 (cell::kLinuxCncMaxDio)
+// [measure]: the dwell before a reading; a transducer's slope (its size also
+// at least 0.1, checked by the reader) and its grooves; the external system's
+// first analog output (the set and repetition go on the next two).
+inline constexpr NumberRange kMeasureDwellS = Closed(0, 60, "s");
+inline constexpr NumberRange kTransducerSlope = Closed(-10, 10, "");
+inline constexpr NumberRange kTransducerGrooves = Whole(2, 10'000);
+inline constexpr NumberRange kExternalNodeOutput = Whole(0, 61);
 // Columns or rows of a pallet (a feeder bank, a tray) or of an imported
 // panel: 10 000 at most, so a count of pick points always fits.
 inline constexpr NumberRange kPalletCount = Whole(1, 10'000);

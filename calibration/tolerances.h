@@ -77,6 +77,11 @@ inline constexpr double kSetShiftFloorMm = 0.001;
 // so any larger miss is a typo or a wrong L1/L2, not a measurement error.
 inline constexpr double kMarkerGeometryTolMm = 1e-6;
 
+// The robot's final approach (robot.final_approach_mm) takes up backlash,
+// which is micrometres to a tenth of a millimetre: a longer approach is a
+// typo (or a unit mistake), and costs time at every target.
+inline constexpr double kMaxFinalApproachMm = 10;
+
 // --- CAD import ----------------------------------------------------------------
 // (frontend/cad_*.cpp, frontend/cad/cad_to_program.cpp; docs/import.md)
 

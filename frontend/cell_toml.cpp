@@ -136,8 +136,10 @@ class Keys {
 
 class Loader {
  public:
-  Loader(SourceManager& sources, Diagnostics& diags, std::uint32_t file, std::filesystem::path dir)
-      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)), locator_(sources, file) {}
+  Loader(SourceManager& sources, Diagnostics& diags, std::uint32_t file, std::filesystem::path dir,
+         CellLoadOptions options)
+      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)), options_(options),
+        locator_(sources, file) {}
 
   Diagnostics& diags() { return diags_; }
 
@@ -151,6 +153,7 @@ class Loader {
  private:
   struct LoadedTable {
     std::optional<std::string> io_error;  // the file could not be read
+    bool missing = false;                 // ... because it does not exist
     bool ok = false;                      // read and valid
     ErrorTable table;
   };
@@ -169,6 +172,7 @@ class Loader {
   bool ReadFixtureLimits(Keys& keys, Fixture& fixture);
   std::optional<Feeder> ReadFeeder(const toml::table& table, int index, Names& names);
   std::optional<LinuxCnc> ReadLinuxCnc(const toml::table& table);
+  std::optional<Measure> ReadMeasure(const toml::table& table);
 
   bool CheckMarkerGeometry(const Fixture& fixture, Keys& keys);
   bool CheckScanTrips(const Fixture& fixture);
@@ -185,6 +189,7 @@ class Loader {
   Diagnostics& diags_;
   std::uint32_t file_;
   std::filesystem::path dir_;
+  CellLoadOptions options_;
   TomlLocator locator_;
   Robot robot_;
   bool robot_ok_ = false;
@@ -495,6 +500,19 @@ void Loader::ReadRobot(const toml::table& table, Robot& robot) {
   }
   robot.servo_period_range = keys.KeyRange("servo_period_s");
   if (auto period = NumberIn(keys, "servo_period_s", limits::kServoPeriodS, Need::kOptional)) robot.servo_period_s = *period;
+  robot.final_approach_range = keys.KeyRange("final_approach_mm");
+  if (auto approach = Point2At(keys, "final_approach_mm", Need::kOptional)) {
+    const Point2& a = approach->value;
+    // Written so that a NaN fails too (every comparison with NaN is false).
+    if (!(a.x() != 0 && a.y() != 0 && a.cwiseAbs().maxCoeff() <= kMaxFinalApproachMm)) {
+      diags_.Report(DiagKind::CellValueOutOfRange, approach->range, "'final_approach_mm'",
+                    fmt::format("[{}, {}]", Num(a.x()), Num(a.y())),
+                    fmt::format("a move along both axes, each component non-zero and within ±{} mm",
+                                Num(kMaxFinalApproachMm)));
+    } else {
+      robot.final_approach_mm = a;
+    }
+  }
   keys.Finish();
   robot_ = robot;
   robot_ok_ = diags_.error_count() == errors_before;
@@ -547,6 +565,8 @@ const Loader::LoadedTable& Loader::LoadTable(const std::string& table_path) {
   Result<std::uint32_t> file = sources_.Load(resolved);
   if (!file) {
     loaded.io_error = file.error().message;
+    std::error_code error;
+    loaded.missing = !std::filesystem::exists(resolved, error) && !error;
     return loaded;
   }
   std::optional<ErrorTable> table = ReadErrorTable(file.value(), diags_);
@@ -625,7 +645,9 @@ std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
       diags_.Report(DiagKind::CellValueOutOfRange, path->range, "'table'", "\"\"", "the path of an error table file");
     } else {
       loaded = &LoadTable(path->value);
-      if (loaded->io_error) {
+      if (loaded->missing && options_.tables_may_be_missing) {
+        region.has_table = false;
+      } else if (loaded->io_error) {
         diags_.Report(DiagKind::CellTableUnreadable, path->range, Printable(region.name), *loaded->io_error);
       } else if (!loaded->ok) {
         diags_.Report(DiagKind::CellTableInvalid, path->range, Printable(path->value), Printable(region.name));
@@ -648,6 +670,21 @@ std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
   }
   keys.Finish();
 
+  if (!region.has_table && bounds_read) {
+    // Planning the first measurement: the bounds say what to measure.
+    if (!x || !y) {
+      diags_.Report(DiagKind::CellRegionNeedsBounds, region.table_range, Printable(region.name),
+                    Printable(region.table_path), !x && !y ? "x_mm and y_mm" : !x ? "x_mm" : "y_mm");
+    } else {
+      region.x_mm = x->value;
+      region.y_mm = y->value;
+      std::string subject = fmt::format("region '{}'", Printable(region.name));
+      CheckInLimit(0, region.x_mm.lo, keys.KeyRange("x_mm"), subject + " x_mm.lo");
+      CheckInLimit(0, region.x_mm.hi, keys.KeyRange("x_mm"), subject + " x_mm.hi");
+      CheckInLimit(1, region.y_mm.lo, keys.KeyRange("y_mm"), subject + " y_mm.lo");
+      CheckInLimit(1, region.y_mm.hi, keys.KeyRange("y_mm"), subject + " y_mm.hi");
+    }
+  }
   if (loaded != nullptr && loaded->ok && bounds_read) {
     region.table = loaded->table;
     region.domain = TableDomain(region.table);
@@ -1051,6 +1088,91 @@ std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
   return linuxcnc;
 }
 
+// ------------------------------------------------------------------ measure
+
+std::optional<Measure> Loader::ReadMeasure(const toml::table& table) {
+  const std::size_t errors_before = diags_.error_count();
+  Keys keys(*this, table, "[measure]", Range(table));
+  Measure m;
+  m.range = Range(table);
+  m.device_range = keys.KeyRange("device");
+  if (Lookup(keys, "device", Need::kRequired, "one of 'transducer', 'probe' or 'external'") != nullptr) {
+    if (std::optional<int> device = Choice(keys, "device", kMeasureDeviceNames)) {
+      m.device = static_cast<MeasureDevice>(*device);
+    }
+  }
+  if (auto z = Number(keys, "z_mm", Need::kRequired, limits::kPositionMm)) {
+    m.z_mm = z->value;
+    CheckInLimit(2, m.z_mm, z->range, "'z_mm' of [measure]");
+  }
+  m.clear_z_mm = robot_.safe_limz_mm;
+  if (auto clear = Number(keys, "clear_z_mm", Need::kOptional, limits::kPositionMm)) {
+    m.clear_z_mm = clear->value;
+    CheckInLimit(2, m.clear_z_mm, clear->range, "'clear_z_mm' of [measure]");
+    if (m.clear_z_mm <= m.z_mm) {
+      diags_.Report(DiagKind::CellValueOutOfRange, clear->range, "'clear_z_mm'", Num(clear->value),
+                    fmt::format("above z_mm = {}", Num(m.z_mm)));
+    }
+  }
+  if (auto dwell = NumberIn(keys, "dwell_s", limits::kMeasureDwellS, Need::kOptional)) m.dwell_s = *dwell;
+  if (auto reading = NumberIn(keys, "reading_time_s", limits::kDwellS, Need::kOptional)) m.reading_time_s = *reading;
+  m.noise_mm = NumberIn(keys, "noise_mm", limits::kAccuracyMm).value_or(0);
+  if (auto timeout = NumberIn(keys, "timeout_s", limits::kTimeoutS, Need::kOptional)) m.timeout_s = *timeout;
+  if (keys.Get("ready_input") != nullptr) {
+    m.ready_input = WholeIn(keys, "ready_input", limits::kLinuxCncInput, "motion.digital-in-NN");
+  }
+  // The device's own table: required for the device named, refused for the others.
+  for (std::size_t d = 0; d < kMeasureDeviceNames.size(); ++d) {
+    const std::string_view name = kMeasureDeviceNames[d];
+    const bool wanted = static_cast<std::size_t>(m.device) == d;
+    const toml::table* device =
+        TableAt(keys, name, wanted ? Need::kRequired : Need::kOptional, fmt::format("a [measure.{}] table", name));
+    if (device == nullptr) continue;
+    if (!wanted) {
+      diags_.Report(DiagKind::CellUnknownKey, keys.KeyRange(name), Printable(std::string(name)), "[measure]",
+                    fmt::format(" (the device is '{}': its table is [measure.{}])",
+                                kMeasureDeviceNames[static_cast<std::size_t>(m.device)],
+                                kMeasureDeviceNames[static_cast<std::size_t>(m.device)]));
+      continue;
+    }
+    Keys sub(*this, *device, fmt::format("[measure.{}]", name), Range(*device));
+    if (m.device == MeasureDevice::kTransducer) {
+      MeasureTransducer& t = m.transducer;
+      t.input = WholeIn(sub, "input", limits::kLinuxCncInput, "motion.analog-in-NN").value_or(0);
+      t.reference_input = WholeIn(sub, "reference_input", limits::kLinuxCncInput, "motion.analog-in-NN").value_or(0);
+      if (auto slope = Number(sub, "slope", Need::kRequired, limits::kTransducerSlope)) {
+        if (std::abs(slope->value) < 0.1) {
+          diags_.Report(DiagKind::CellValueOutOfRange, slope->range, "'slope'", Num(slope->value),
+                        "within 0.1 to 10 in size (a 45 degree flank: 1 or -1)");
+        } else {
+          t.slope = slope->value;
+        }
+      }
+      if (auto zero = Number(sub, "zero_mm", Need::kOptional, limits::kPositionMm)) t.zero_mm = zero->value;
+      if (auto range = IntervalAt(sub, "range_mm", Need::kRequired, limits::kPositionMm)) t.range_mm = range->value;
+      t.groove_pitch_mm = NumberIn(sub, "groove_pitch_mm", limits::kLengthMm).value_or(1);
+      t.grooves = WholeIn(sub, "grooves", limits::kTransducerGrooves, "grooves per direction").value_or(2);
+    } else if (m.device == MeasureDevice::kProbe) {
+      MeasureProbe& p = m.probe;
+      p.hole_diameter_mm = NumberIn(sub, "hole_diameter_mm", limits::kLengthMm).value_or(0);
+      p.hole_pitch_mm = NumberIn(sub, "hole_pitch_mm", limits::kLengthMm).value_or(1);
+      p.stylus_diameter_mm = NumberIn(sub, "stylus_diameter_mm", limits::kLengthMm).value_or(0);
+      p.speed_mm_s = NumberIn(sub, "speed_mm_s", limits::kSpeedMmS).value_or(1);
+      p.overtravel_mm = NumberIn(sub, "overtravel_mm", limits::kLengthMm).value_or(0.5);
+    } else {
+      MeasureExternal& e = m.external;
+      e.trigger_output = WholeIn(sub, "trigger_output", limits::kLinuxCncInput, "motion.digital-out-NN").value_or(0);
+      e.done_input = WholeIn(sub, "done_input", limits::kLinuxCncInput, "motion.digital-in-NN").value_or(0);
+      e.node_output = WholeIn(sub, "node_output", limits::kExternalNodeOutput,
+                              "motion.analog-out-NN; the set and repetition go on the next two").value_or(0);
+    }
+    sub.Finish();
+  }
+  keys.Finish();
+  if (diags_.error_count() != errors_before) return std::nullopt;
+  return m;
+}
+
 std::string DefaultCellName(const std::string& path) {
   if (path == "-") return "cell";
   std::string name = std::filesystem::path(path).filename().string();
@@ -1095,6 +1217,9 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   if (const toml::table* linuxcnc = TableAt(keys, "linuxcnc", Need::kOptional, "a [linuxcnc] table")) {
     cell.linuxcnc = ReadLinuxCnc(*linuxcnc);
   }
+  if (const toml::table* measure = TableAt(keys, "measure", Need::kOptional, "a [measure] table")) {
+    cell.measure = ReadMeasure(*measure);
+  }
   keys.Finish();
 
   CheckUniqueNames(region_names, "region");
@@ -1120,11 +1245,16 @@ std::string ParseErrorText(std::string_view description) {
 // ------------------------------------------------------------------ public
 
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags) {
+  return LoadCell(path, sources, diags, CellLoadOptions{});
+}
+
+Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                     const CellLoadOptions& options) {
   Result<std::uint32_t> file = sources.Load(path);
   if (!file) return file.error();
   const SourceFile& source = sources.File(file.value());
   std::filesystem::path dir = path == "-" ? std::filesystem::path() : std::filesystem::path(path).parent_path();
-  Loader loader(sources, diags, file.value(), dir);
+  Loader loader(sources, diags, file.value(), dir, options);
   toml::table root;
   try {
     root = toml::parse(std::string_view(source.text), std::string_view(source.name));

@@ -13,6 +13,8 @@
 #include "base/diagnostics.h"
 #include "base/number_range.h"
 #include "base/result.h"
+#include "calibration/cell.h"
+#include "frontend/measurement_input.h"
 
 namespace smtcal::tools {
 
@@ -90,5 +92,20 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options);
 void AddCellCommand(CLI::App& app, GlobalOptions& options);
 void AddDiffCommand(CLI::App& app, GlobalOptions& options);
 void AddSimulateCommand(CLI::App& app, GlobalOptions& options);
+// `smtcal measure plan|program|read` (cmd_measure*.cpp): the family, and each command.
+void AddMeasureCommand(CLI::App& app, GlobalOptions& options);
+void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options);
+void AddMeasureProgramCommand(CLI::App& measure, GlobalOptions& options);
+void AddMeasureReadCommand(CLI::App& measure, GlobalOptions& options);
+// The cell of a measurement: tables may be missing; it needs [measure] and
+// robot.final_approach_mm. False (diagnostics printed, exit code set) when
+// it cannot be used.
+bool LoadCellForMeasure(const std::string& path, SourceManager& sources, Diagnostics& diags, GlobalOptions& options,
+                        std::optional<cell::Cell>& cell);
+// ... and the plan made for it (frontend/measurement_input.h); false, with
+// the diagnostics printed and the exit code set, when either cannot be used.
+bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path, SourceManager& sources,
+                     Diagnostics& diags, GlobalOptions& options, std::optional<cell::Cell>& cell,
+                     std::optional<measure::LoadedPlan>& plan);
 
 }  // namespace smtcal::tools

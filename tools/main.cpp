@@ -212,6 +212,7 @@ int main(int argc, char** argv) {
   AddCellCommand(app, options);
   AddDiffCommand(app, options);
   AddSimulateCommand(app, options);
+  AddMeasureCommand(app, options);
   int exit_code = Prescan(argc, argv);
   try {
     if (exit_code == kExitOk) exit_code = Run(app, argc, argv, options);

@@ -32,6 +32,7 @@ struct LinuxCncOutput {
   std::string main_name;                  // "<program file stem>.ngc"
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
   std::vector<EmbeddedFile> dry_run;      // OUTDIR/dry-run/ (--dry-run-probe, linuxcnc_dry_run.h), or none
+  std::vector<EmbeddedFile> more_mains;   // further programs beside the main one (the measuring programs), or none
 };
 
 // Lowers the program, writing the main program's text to `main` as it is

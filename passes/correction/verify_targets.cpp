@@ -18,6 +18,7 @@
 
 #include <fmt/format.h>
 
+#include "calibration/motion_time.h"
 #include "ir/constant_fold.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
@@ -26,14 +27,6 @@
 namespace smtcal {
 
 namespace {
-
-// Time to move `distance` with a trapezoidal profile (triangular when short).
-double MoveTime(double distance, double speed, double accel) {
-  distance = std::abs(distance);
-  if (distance == 0 || speed <= 0 || accel <= 0) return 0;
-  if (distance < speed * speed / accel) return 2 * std::sqrt(distance / accel);
-  return distance / speed + speed / accel;
-}
 
 class VerifyTargets final : public Pass {
  public:
