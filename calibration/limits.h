@@ -85,6 +85,12 @@ inline constexpr NumberRange kMeasureDwellS = Closed(0, 60, "s");
 inline constexpr NumberRange kTransducerSlope = Closed(-10, 10, "");
 inline constexpr NumberRange kTransducerGrooves = Whole(2, 10'000);
 inline constexpr NumberRange kExternalNodeOutput = Whole(0, 61);
+// smtcal measure: the grid pitch, sets x repetitions per node, the visit a
+// program resumes at.
+inline constexpr NumberRange kMeasurePitchMm = Closed(0.1, 1000, "mm");
+inline constexpr NumberRange kMeasureSets = Whole(1, 100);
+inline constexpr NumberRange kMeasureRepetitions = Whole(1, 1000);
+inline constexpr NumberRange kMeasureStartVisit = Whole(1, 1e9);
 // Columns or rows of a pallet (a feeder bank, a tray) or of an imported
 // panel: 10 000 at most, so a count of pick points always fits.
 inline constexpr NumberRange kPalletCount = Whole(1, 10'000);

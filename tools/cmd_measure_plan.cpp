@@ -10,6 +10,7 @@
 #include "backend/reports/measurement_csv.h"
 #include "calibration/measurement_plan.h"
 #include "frontend/cell_toml.h"
+#include "calibration/limits.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {
@@ -26,7 +27,7 @@ struct PlanOptionsCli {
 };
 
 void RunPlan(const PlanOptionsCli& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("-o", opt.output, {opt.cell})) {
+  if (FilesClash({{"--cell", opt.cell}}, {{"-o", opt.output}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -76,13 +77,12 @@ void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options) {
   plan->add_option("--cell", opt.cell, "the cell file ([measure] describes the device)")->required();
   plan->add_option("-o,--output", opt.output, "the plan to write (CSV; '-' for stdout)")->required();
   plan->add_option("--region", opt.regions, "measure only this region (repeatable; default: every region)");
-  plan->add_option("--pitch", opt.pitch_mm, "the grid pitch in mm (default: from the tolerance or the previous table)")
-      ->check(CLI::Range(0.1, 1000.0));
-  plan->add_option("--sets", opt.sets, "sets of repetitions per node (the paper: 2)")
-      ->check(CLI::Range(1, 100))
+  AddNumberOption(*plan, "--pitch", opt.pitch_mm,
+                  "the grid pitch in mm (default: from the tolerance or the previous table)", limits::kMeasurePitchMm);
+  AddNumberOption(*plan, "--sets", opt.sets, "sets of repetitions per node (the paper: 2)", limits::kMeasureSets)
       ->capture_default_str();
-  plan->add_option("--repetitions", opt.repetitions, "repetitions per node and set (the paper: 10)")
-      ->check(CLI::Range(1, 1000))
+  AddNumberOption(*plan, "--repetitions", opt.repetitions, "repetitions per node and set (the paper: 10)",
+                  limits::kMeasureRepetitions)
       ->capture_default_str();
   plan->add_flag("--no-check-points", opt.no_check_points,
                  "no check points between nodes (the interpolation error is then estimated from the table alone)");

@@ -12,6 +12,7 @@
 #include "backend/linuxcnc/linuxcnc_measure.h"
 #include "frontend/cell_toml.h"
 #include "frontend/measurement_input.h"
+#include "calibration/limits.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {
@@ -26,7 +27,7 @@ struct ProgramOptions {
 };
 
 void RunProgram(const ProgramOptions& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("-o", opt.output, {opt.plan, opt.cell})) {
+  if (FilesClash({{"PLAN", opt.plan}, {"--cell", opt.cell}}, {{"-o", opt.output, true}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -39,8 +40,7 @@ void RunProgram(const ProgramOptions& opt, GlobalOptions& options) {
   if (options.exit_code != kExitOk) return;
   const int visits = static_cast<int>(plan->plan.visits.size());
   if (opt.start > visits) {
-    fmt::print(stderr, "smtcal: error: --start {}: the plan has {} visits\n", opt.start, visits);
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(fmt::format("--start {}: the plan has {} visits", opt.start, visits));
     return;
   }
   MeasuringPrograms programs = EmitMeasuringPrograms(*plan, *cell, opt.start, opt.log_dir);
@@ -122,10 +122,10 @@ void AddMeasureProgramCommand(CLI::App& measure, GlobalOptions& options) {
   program->add_option("--cell", opt.cell, "the cell file the plan was made for")->required();
   program->add_option("-o,--output", opt.output, "the output directory (replaced only when smtcal wrote it)")
       ->required();
-  program->add_option("--start", opt.start,
-                      "resume at this visit: programs before it are left out, the one holding it starts there and\n"
-                      "appends to its log (LOGAPPEND)")
-      ->check(CLI::PositiveNumber)
+  AddNumberOption(*program, "--start", opt.start,
+                  "resume at this visit: programs before it are left out, the one holding it starts there and\n"
+                  "appends to its log (LOGAPPEND)",
+                  limits::kMeasureStartVisit)
       ->capture_default_str();
   program->add_option("--log-dir", opt.log_dir,
                       "where the controller writes the logs (default: LinuxCNC's working directory, the folder of\n"

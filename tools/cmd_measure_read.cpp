@@ -61,11 +61,12 @@ std::vector<measure::Reading> MergeReadings(const std::vector<measure::Measuring
 }
 
 void RunRead(const ReadOptions& opt, GlobalOptions& options) {
-  std::vector<std::string> inputs = opt.logs;
-  inputs.push_back(opt.plan);
-  inputs.push_back(opt.cell);
-  inputs.push_back(opt.external);
-  if (OutputOverwritesInput("-o", opt.output, inputs)) {
+  std::vector<NamedFile> inputs;
+  for (const std::string& log : opt.logs) inputs.push_back({"LOG", log});
+  inputs.push_back({"PLAN", opt.plan});
+  inputs.push_back({"--cell", opt.cell});
+  inputs.push_back({"--external", opt.external});
+  if (FilesClash(inputs, {{"-o", opt.output}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -84,10 +85,10 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
   if (!region) {
     std::string names;
     for (const measure::PlanRegion& r : plan->plan.regions) names += (names.empty() ? "" : ", ") + r.name;
-    fmt::print(stderr, "smtcal: error: {}: name the region to read with --region (the plan has {})\n",
-               opt.region.empty() ? "the plan measures several regions" : "--region " + opt.region + " is not in the plan",
-               names);
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(fmt::format(
+        "{}: name the region to read with --region (the plan has {})",
+        opt.region.empty() ? "the plan measures several regions" : "--region " + opt.region + " is not in the plan",
+        names));
     return;
   }
   const measure::PlanRegion& grid = plan->plan.regions[*region];
@@ -152,8 +153,8 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
   }
   if (device.device == cell::MeasureDevice::kExternal) {
     if (opt.external.empty()) {
-      fmt::print(stderr, "smtcal: error: the device is external: give its readings with --external READINGS.csv\n");
-      options.exit_code = kExitUsageError;
+      options.exit_code =
+          ReportUsageError("the device is external: give its readings with --external READINGS.csv");
       return;
     }
     Result<std::uint32_t> file = sources.Load(opt.external);
