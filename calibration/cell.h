@@ -174,8 +174,19 @@ struct Fixture {
   // import asks for --place-z instead of guessing.
   std::optional<double> place_z_mm;
   SourceRange place_z_range;  // the place_z_mm key
+  // The pocket boards sit in (pocket_x_mm, pocket_y_mm: x and y intervals in
+  // the fixture frame): `smtcal import` puts a board's outline, turned over
+  // for its bottom side, into the pocket's lower left corner, so the top and
+  // the bottom of one board are placed where the board really lies. Absent:
+  // import centres the board on a calibrated region instead.
+  std::optional<std::array<Interval, 2>> pocket_mm;
+  SourceRange pocket_range;  // the pocket_x_mm key
   SourceRange range;  // the [[fixture]] table
 };
+
+// How far a pocket may reach from the fixture origin (mm): a board is
+// centimetres, a fixture less than a metre.
+inline constexpr double kMaxPocketMm = 2000;
 
 // What a feeder holds, for CAD import: a tape gives every part of one kind
 // from the same pick point (a pallet of tapes is a bank of lanes, one kind

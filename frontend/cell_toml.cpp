@@ -192,6 +192,7 @@ class Loader {
   // Robot-limit checks; `robot_ok_` says whether [robot] was read cleanly.
   void CheckInLimit(int axis, double value, SourceRange where, const std::string& subject);
   void CheckPointInLimits(const std::array<double, 4>& point, SourceRange where, const std::string& subject);
+  void ReadPocket(Keys& keys, Fixture& fixture);
 
   SourceManager& sources_;
   Diagnostics& diags_;
@@ -531,7 +532,10 @@ void Loader::CheckInLimit(int axis, double value, SourceRange where, const std::
   if (!robot_ok_) return;
   const Interval& limit = robot_.limits[static_cast<std::size_t>(axis)];
   if (limit.Contains(value)) return;
-  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where, fmt::format("{} = {}", subject, Num(value)),
+  // Computed points (a scan path at the nominal pose, a pallet's far corner)
+  // are shown to 1 nm, without the noise of their arithmetic.
+  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where,
+                                   fmt::format("{} = {}", subject, Num(std::round(value * 1e6) / 1e6)),
                                    kTaskAxisNames[static_cast<std::size_t>(axis)], Num(limit.lo), Num(limit.hi),
                                    kLimitUnits[static_cast<std::size_t>(axis)]);
   Diagnostics::AddNote(diag, robot_.limit_keys[static_cast<std::size_t>(axis)],
@@ -877,6 +881,35 @@ void Loader::CheckTeachTrips(const Fixture& fixture) {
   }
 }
 
+// pocket_x_mm, pocket_y_mm: where `smtcal import` puts boards on this
+// fixture (docs/cell.md). Both or neither; each [lo, hi] within
+// ±kMaxPocketMm of the fixture origin.
+void Loader::ReadPocket(Keys& keys, Fixture& fixture) {
+  std::optional<Located<Interval>> x = IntervalAt(keys, "pocket_x_mm", Need::kOptional, "mm");
+  std::optional<Located<Interval>> y = IntervalAt(keys, "pocket_y_mm", Need::kOptional, "mm");
+  bool ok = true;
+  for (const auto& [interval, key] : {std::pair{&x, "pocket_x_mm"}, std::pair{&y, "pocket_y_mm"}}) {
+    if (!*interval) continue;
+    for (double bound : {(*interval)->value.lo, (*interval)->value.hi}) {
+      if (std::abs(bound) > kMaxPocketMm) {
+        diags_.Report(DiagKind::CellValueOutOfRange, (*interval)->range, Quoted(key), Num(bound),
+                      fmt::format("within -{0} to {0} mm of the fixture origin", Num(kMaxPocketMm)));
+        ok = false;
+      }
+    }
+  }
+  const bool has_x = keys.Get("pocket_x_mm") != nullptr, has_y = keys.Get("pocket_y_mm") != nullptr;
+  if (has_x != has_y) {
+    diags_.Report(DiagKind::CellMissingKey, keys.KeyRange(has_x ? "pocket_x_mm" : "pocket_y_mm"), keys.what(),
+                  has_x ? "pocket_y_mm" : "pocket_x_mm",
+                  "a pocket is a rectangle, pocket_x_mm = [lo, hi] and pocket_y_mm = [lo, hi] in the fixture frame");
+    return;
+  }
+  if (!ok || !x || !y) return;
+  fixture.pocket_mm = std::array<Interval, 2>{x->value, y->value};
+  fixture.pocket_range = x->range;
+}
+
 std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
                                            std::vector<Located<std::string>>& names) {
   const std::size_t errors_before = diags_.error_count();
@@ -915,6 +948,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
     fixture.place_z_mm = place_z->value;
     fixture.place_z_range = keys.KeyRange("place_z_mm");
   }
+  ReadPocket(keys, fixture);
   fixture.scan_speed_mm_s = PositiveNumber(keys, "scan_speed_mm_s", "mm/s").value_or(0);
   std::optional<double> window = PositiveNumber(keys, "trip_window_mm", "mm");
   fixture.trip_window_mm = window.value_or(0);

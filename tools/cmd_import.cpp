@@ -13,6 +13,8 @@
 #include <fmt/core.h>
 
 #include "backend/place/place_printer.h"
+#include "backend/reports/import_report.h"
+#include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_reader.h"
@@ -40,7 +42,11 @@ struct ImportCliOptions {
   std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
-  std::string origin;  // empty: centred on the fixture's largest calibrated region (BoardSpot)
+  std::string origin;  // empty: in the fixture's pocket, else centred on its largest calibrated region (BoardSpot)
+  std::string board;   // --board W,H or X,Y,W,H: the outline in the list's coordinates
+  std::string report;       // --report FILE.json
+  std::string setup_sheet;  // --setup-sheet FILE: the feeder set-up sheet as text
+  std::string setup_csv;    // --setup-csv FILE: the same as CSV
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
@@ -92,6 +98,23 @@ CLI::Validator PairValidator() {
                                                  "space, e.g. 10.5,20 or -5,10";
       },
       "X,Y");
+}
+
+// "W,H" or "X,Y,W,H" -> the outline x0, y0, x1, y1 (W, H > 0).
+std::optional<std::array<double, 4>> ParseBoard(const std::string& text) {
+  std::vector<double> numbers;
+  std::size_t start = 0;
+  for (;;) {
+    std::size_t comma = text.find(',', start);
+    std::optional<double> number = ParseNumber(text.substr(start, comma == std::string::npos ? comma : comma - start));
+    if (!number || !std::isfinite(*number) || std::abs(*number) > kMaxLengthMm) return std::nullopt;
+    numbers.push_back(*number);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (numbers.size() == 2) numbers.insert(numbers.begin(), {0.0, 0.0});
+  if (numbers.size() != 4 || numbers[2] <= 0 || numbers[3] <= 0) return std::nullopt;
+  return std::array<double, 4>{numbers[0], numbers[1], numbers[0] + numbers[2], numbers[1] + numbers[3]};
 }
 
 // "CxR" -> columns and rows of a panel.
@@ -212,6 +235,13 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
   std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : *ParsePair(opt.origin);
+  if (!opt.board.empty()) import.board = ParseBoard(opt.board);
+  if (fixture.pocket_mm) {
+    const auto& [x, y] = *fixture.pocket_mm;
+    import.pocket = std::array<double, 4>{x.lo, y.lo, x.hi, y.hi};
+    import.pocket_range = fixture.pocket_range;
+  }
+  import.keep_fates = !opt.report.empty();
   std::array<double, 2> pitch = *ParsePair(opt.pitch);
   import.origin_given = !opt.origin.empty();
   std::array<int, 2> panel = *ParsePanel(opt.panel);
@@ -243,7 +273,10 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
   std::vector<std::string> inputs = {opt.list, opt.cell};
   if (!opt.feeders.empty()) inputs.push_back(opt.feeders);
-  if (OutputOverwritesInput("-o", opt.output, inputs)) {
+  if (OutputOverwritesInput("-o", opt.output, inputs) ||
+      (!opt.report.empty() && OutputOverwritesInput("--report", opt.report, inputs)) ||
+      (!opt.setup_sheet.empty() && OutputOverwritesInput("--setup-sheet", opt.setup_sheet, inputs)) ||
+      (!opt.setup_csv.empty() && OutputOverwritesInput("--setup-csv", opt.setup_csv, inputs))) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -299,8 +332,6 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     import.centre_spot = spot->first;
     import.centre_spot_name = spot->second;
   }
-  const bool origin_given = import.origin_given;
-  const std::string spot_name = import.centre_spot ? import.centre_spot_name : std::string();
   const std::string place_z_source =
       opt.place_z_mm ? std::string("--place-z") : fmt::format("place_z_mm of fixture {}", fixture->name);
   const double place_z = import.place_z_mm;
@@ -320,22 +351,35 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::string summary = FormatImportSummary(importer.summary());
   if (program) {
     const ImportSummary& s = importer.summary();
-    summary += fmt::format("  board:   origin ({}, {}) mm in fixture {}{}\n  place:   at z = {} mm ({})\n",
-                           s.origin_x_mm, s.origin_y_mm, fixture->name,
-                           origin_given       ? " (--origin)"
-                           : spot_name.empty() ? fmt::format(": the fixture carries no calibrated region to centre the "
-                                                             "parts on; give --origin X,Y")
-                                               : fmt::format(", the parts centred on {} (--origin X,Y to place the "
-                                                             "board elsewhere)",
-                                                             spot_name),
-                           place_z, place_z_source);
+    summary += fmt::format("  board:   outline {}\n           origin ({}, {}) mm in fixture {}: {}\n"
+                           "  place:   at z = {} mm ({})\n",
+                           s.outline, s.origin_x_mm, s.origin_y_mm, fixture->name, s.origin_how, place_z,
+                           place_z_source);
   }
   if (options.exit_code != kExitOk || !program) {
     std::fputs(summary.c_str(), stderr);
     options.exit_code = kExitInputError;
     return;  // nothing half-written
   }
-  Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
+  // Every output is staged first, complete, beside its file, and then all
+  // are renamed into place: a run that cannot write one writes none.
+  std::vector<std::pair<std::string, std::string>> outputs = {{opt.output, PrintPlace(*program)}};
+  if (!opt.report.empty()) {
+    outputs.emplace_back(opt.report, ImportReportJson(importer.summary(), importer.fates(), BaseName(opt.list)));
+  }
+  if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(importer.setup_sheet()));
+  if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(importer.setup_sheet()));
+  std::vector<StagedOutput> staged;
+  Status written = Ok{};
+  for (const auto& [path, text] : outputs) {
+    Result<StagedOutput> stage = StagedOutput::Stage(path, text);
+    if (!stage) {
+      written = stage.error();
+      break;
+    }
+    staged.push_back(std::move(stage).value());
+  }
+  for (std::size_t i = 0; written && i < staged.size(); ++i) written = staged[i].Commit();
   if (!written) {
     std::fputs(summary.c_str(), stderr);
     options.exit_code = ReportIoError(written.error());
@@ -393,9 +437,19 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   // Where the board is.
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
-                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
-                  "on the largest calibrated region on the fixture, else 0,0)")
+                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the board's outline in\n"
+                  "the fixture's pocket, else centred on its largest calibrated region, else 0,0)")
       ->check(PairValidator());
+  cmd->add_option("--board", opt.board,
+                  "W,H or X,Y,W,H: the board's outline in the list's coordinates seen from the top, mm (its\n"
+                  "lower left corner X,Y, default 0,0: where KiCad's drill/place file origin is when it\n"
+                  "was put on that corner); a part outside it is an error (default: the parts' bounding box)")
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            return ParseBoard(text) ? std::string()
+                                    : "expected W,H or X,Y,W,H in mm with W and H > 0, e.g. 16.6,40.1 or -5,0,50,30";
+          },
+          "W,H"));
   cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
       ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
   cmd->add_option("--mirror", opt.mirror,
@@ -433,6 +487,10 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
       ->check(CLI::IsMember({"signed", "positive"}))
       ->capture_default_str();
   cmd->add_option("--name", opt.name, "the program's name (default: from the output file's name)");
+  cmd->add_option("--report", opt.report, "write the import report: every row of the list and what became of it (JSON)");
+  cmd->add_option("--setup-sheet", opt.setup_sheet,
+                  "write the feeder set-up sheet, which part goes in which feeder, lane or pocket, as a text table");
+  cmd->add_option("--setup-csv", opt.setup_csv, "write the feeder set-up sheet as CSV");
   cmd->footer(
       "Every row becomes a placement or a diagnostic at its line; the summary on stderr counts rows\n"
       "read, placed and skipped by reason. Exit codes: 0 ok, 1 errors in the list, the cell or the\n"

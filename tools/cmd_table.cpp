@@ -95,8 +95,9 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
 void RunCheck(const TableOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  if (LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
+  if (std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
     options.exit_code = PrintDiagnostics(diags, options);
+    if (options.exit_code == kExitOk) SayDone(options, "", NoErrorsText(table->name, diags.warning_count()));
   }
 }
 

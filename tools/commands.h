@@ -32,6 +32,8 @@ struct GlobalOptions {
 // with -q, or when `output` is standard output ("-": the output speaks for
 // itself).
 void SayDone(const GlobalOptions& options, const std::string& output, std::string_view what);
+// "layers.place: no errors, 2 warnings": what a check that found no error says.
+std::string NoErrorsText(std::string_view name, std::size_t warnings);
 
 // Prints the diagnostics to stderr in the chosen format. Returns
 // kExitInputError if any is an error, else kExitOk.

@@ -26,6 +26,13 @@ void SayDone(const GlobalOptions& options, const std::string& output, std::strin
   fmt::print(stderr, "smtcal: {}\n", what);
 }
 
+std::string NoErrorsText(std::string_view name, std::size_t warnings) {
+  return fmt::format("{}: no errors, {}", name,
+                     warnings == 0   ? std::string("no warnings")
+                     : warnings == 1 ? std::string("1 warning")
+                                     : fmt::format("{} warnings", warnings));
+}
+
 int ReportIoError(const Error& error) {
   fmt::print(stderr, "smtcal: error: {}\n", error.message);
   return kExitIoError;
