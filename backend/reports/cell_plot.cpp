@@ -316,7 +316,7 @@ void DrawAxes(std::string& svg, const View& view) {
                        Num(view.top + height + 18), SvgTickText(x, step));
   }
   for (double y : SvgTicks(view.world.y0, view.world.y1, step)) {
-    svg += fmt::format("  <line x1=\"{}\" y1=\"{2}\" x2=\"{1}\" y2=\"{2}\" stroke=\"#444\"/>\n", Num(view.left - 5),
+    svg += fmt::format("  <line x1=\"{0}\" y1=\"{2}\" x2=\"{1}\" y2=\"{2}\" stroke=\"#444\"/>\n", Num(view.left - 5),
                        Num(view.left), Num(view.Py(y)));
     svg += fmt::format("  <text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>\n", Num(view.left - 8),
                        Num(view.Py(y) + 4), SvgTickText(y, step));

@@ -70,7 +70,7 @@ std::string ImportReportJson(const ImportSummary& summary, const std::vector<Row
   }
   out["rows"] = ordered_json::array();
   for (const RowFate& fate : fates) {
-    ordered_json row = {{"line", fate.line}};
+    ordered_json row = {{"line", fate.row.line}};
     if (fate.reason == SkipReason::kNoDesignator) {
       row["fate"] = "skipped";
       row["reason"] = SkipReasonName(fate.reason);
@@ -78,13 +78,13 @@ std::string ImportReportJson(const ImportSummary& summary, const std::vector<Row
       out["rows"].push_back(std::move(row));
       continue;
     }
-    row["designator"] = Printable(fate.designator);
-    row["value"] = Printable(fate.value);
-    row["package"] = Printable(fate.package);
-    row["side"] = cad::SideName(fate.side);
-    row["x_mm"] = fate.x_mm;
-    row["y_mm"] = fate.y_mm;
-    row["rotation_deg"] = fate.rotation_deg;
+    row["designator"] = Printable(fate.row.designator);
+    row["value"] = Printable(fate.row.value);
+    row["package"] = Printable(fate.row.package);
+    row["side"] = cad::SideName(fate.row.side);
+    row["x_mm"] = fate.row.x_mm;
+    row["y_mm"] = fate.row.y_mm;
+    row["rotation_deg"] = fate.row.rotation_deg;
     row["fate"] = fate.placed ? "placed" : "skipped";
     if (fate.placed) {
       row["feeder"] = Printable(fate.feeder);

@@ -395,8 +395,7 @@ void CadImporter::Add(const cad::Row& row) {
   part.side_range = row.side_range;
   if (!Classify(row, part)) part.feeder = FindFeeder(row);
   if (options_.keep_fates) {
-    fates_.push_back(RowFate{row.line, row.designator, row.value, row.package, row.side, row.x_mm, row.y_mm,
-                             row.rotation_deg});
+    fates_.emplace_back().row = row;
   }
   parts_.push_back(std::move(part));
 }
@@ -582,7 +581,7 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
       group.names.push_back(fmt::format("line {}", line));
       if (options_.keep_fates) {
         RowFate fate;
-        fate.line = line;
+        fate.row.line = line;
         fate.reason = SkipReason::kNoDesignator;
         fate.why = group.why;
         fates_.push_back(std::move(fate));
@@ -622,7 +621,7 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   std::optional<ir::Program> program = Build(placed, side, bottom_positions);
   std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
   if (options_.keep_fates) {
-    std::stable_sort(fates_.begin(), fates_.end(), [](const RowFate& a, const RowFate& b) { return a.line < b.line; });
+    std::stable_sort(fates_.begin(), fates_.end(), [](const RowFate& a, const RowFate& b) { return a.row.line < b.row.line; });
   }
   if (!program || diags_.has_errors()) {
     summary_.failed = true;

@@ -111,10 +111,7 @@ struct SkipGroup {
 
 // What became of one row of the list (the import report, --report).
 struct RowFate {
-  std::uint32_t line = 0;
-  std::string designator, value, package;
-  cad::Side side = cad::Side::kTop;
-  double x_mm = 0, y_mm = 0, rotation_deg = 0;  // as the list writes them
+  cad::Row row;  // as the list writes it (only its line for a row without a designator)
   bool placed = false;
   SkipReason reason = SkipReason::kCount;  // when skipped
   std::string why;                         // when skipped: the rule

@@ -309,7 +309,7 @@ TEST(CadImport, BothSidesOfAKicadBoardUseTheSamePocket) {
     std::array<double, 4> origin{};
     std::map<std::string, std::array<double, 4>> placed;
     for (const ir::StmtPtr& stmt : r.program->items) {
-      if (const auto* local = std::get_if<ir::LocalDecl>(&stmt->node)) origin = local->coords.values;
+      if (const auto* local = std::get_if<ir::LocalDecl>(&stmt->node)) origin = local->origin.values;
       if (const auto* point = std::get_if<ir::PointDecl>(&stmt->node); point != nullptr && point->frame == "Pcb") {
         placed[point->name] = point->coords.values;
       }
