@@ -216,7 +216,21 @@ struct Feeder {
   FeederKind kind = FeederKind::kTape;
   SourceRange kind_range;  // the kind key (the [[feeder]] table when absent)
   SourceRange range;  // the [[feeder]] table
+
+  int pick_points() const { return columns * rows; }  // 1 without a pallet
+  // Pick point k (1-based, PalletPickPoint's order).
+  std::array<double, 4> PickPoint(int k) const;
 };
+
+// Pick point k (1 .. columns * rows) of a pallet, in the order of the
+// language's Pallet(n, k): along the first row from `first` to `last`, then
+// row after row toward `back` (the first column of the last row; `first`
+// when absent). Without `last` (one pick point) it is `first`. The cell's
+// feeders, the feeders file's and the picture of the cell all use it.
+std::array<double, 4> PalletPickPoint(const std::array<double, 4>& first,
+                                      const std::optional<std::array<double, 4>>& last,
+                                      const std::optional<std::array<double, 4>>& back, int columns, int rows,
+                                      int k);
 
 // [linuxcnc]: how the cell's LinuxCNC controller is wired, for
 // `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that

@@ -14,6 +14,7 @@
 
 #include "backend/place/place_printer.h"
 #include "backend/reports/import_report.h"
+#include "backend/reports/setup_sheet.h"
 #include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
@@ -369,17 +370,7 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   }
   if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(importer.setup_sheet()));
   if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(importer.setup_sheet()));
-  std::vector<StagedOutput> staged;
-  Status written = Ok{};
-  for (const auto& [path, text] : outputs) {
-    Result<StagedOutput> stage = StagedOutput::Stage(path, text);
-    if (!stage) {
-      written = stage.error();
-      break;
-    }
-    staged.push_back(std::move(stage).value());
-  }
-  for (std::size_t i = 0; written && i < staged.size(); ++i) written = staged[i].Commit();
+  Status written = WriteFilesAtomically(outputs);
   if (!written) {
     std::fputs(summary.c_str(), stderr);
     options.exit_code = ReportIoError(written.error());

@@ -56,5 +56,6 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options);
 void AddCellCommand(CLI::App& app, GlobalOptions& options);
 void AddDiffCommand(CLI::App& app, GlobalOptions& options);
 void AddSimulateCommand(CLI::App& app, GlobalOptions& options);
+void AddSetupSheetCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

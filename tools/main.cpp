@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
   AddCellCommand(app, options);
   AddDiffCommand(app, options);
   AddSimulateCommand(app, options);
+  AddSetupSheetCommand(app, options);
   int exit_code = kExitOk;
   try {
     exit_code = Run(app, argc, argv, options);

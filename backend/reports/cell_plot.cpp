@@ -72,20 +72,12 @@ View Fit(const Box& world, double left, double top, double max_width, double max
   return view;
 }
 
-// The pick points of a feeder in Pallet(n, k) order (k = (row - 1) * columns + column).
+// The pick points of a feeder in Pallet(n, k) order.
 std::vector<Eigen::Vector2d> PickPoints(const cell::Feeder& feeder) {
   std::vector<Eigen::Vector2d> points;
-  const Eigen::Vector2d first(feeder.pick[0], feeder.pick[1]);
-  if (!feeder.pallet_last) return {first};
-  const Eigen::Vector2d last((*feeder.pallet_last)[0], (*feeder.pallet_last)[1]);
-  const Eigen::Vector2d back = feeder.pallet_back ? Eigen::Vector2d((*feeder.pallet_back)[0], (*feeder.pallet_back)[1])
-                                                  : first;
-  for (int j = 0; j < feeder.rows; ++j) {
-    for (int i = 0; i < feeder.columns; ++i) {
-      const double along = feeder.columns > 1 ? static_cast<double>(i) / (feeder.columns - 1) : 0.0;
-      const double down = feeder.rows > 1 ? static_cast<double>(j) / (feeder.rows - 1) : 0.0;
-      points.push_back(first + along * (last - first) + down * (back - first));
-    }
+  for (int k = 1; k <= feeder.pick_points(); ++k) {
+    const std::array<double, 4> p = feeder.PickPoint(k);
+    points.emplace_back(p[0], p[1]);
   }
   return points;
 }

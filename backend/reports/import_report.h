@@ -1,7 +1,6 @@
-// What `smtcal import` writes besides the program: the import report
-// (--report FILE.json: every row of the list and what became of it) and the
-// feeder set-up sheet (--setup-sheet FILE: which part goes in which feeder,
-// lane or pocket), as text or CSV. docs/import.md describes both.
+// The import report that `smtcal import --report FILE.json` writes beside
+// the program: every row of the list and what became of it
+// (docs/import.md). The set-up sheet it also writes is setup_sheet.h's.
 #pragma once
 
 #include <string>
@@ -15,11 +14,5 @@ namespace smtcal {
 // its designators, and one entry per row in list order.
 std::string ImportReportJson(const ImportSummary& summary, const std::vector<RowFate>& fates,
                              const std::string& list_name);
-
-// The set-up sheet as a text table for the operator, and as CSV (one row per
-// feeder slot: feeder, kind, slot, count, value, package, designators, pick
-// point).
-std::string SetupSheetText(const SetupSheet& sheet);
-std::string SetupSheetCsv(const SetupSheet& sheet);
 
 }  // namespace smtcal

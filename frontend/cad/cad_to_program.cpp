@@ -326,8 +326,12 @@ std::string FormatImportSummary(const ImportSummary& s) {
       text += fmt::format("    {}: {} part{}\n", group.why, n, n == 1 ? "" : "s");
       continue;
     }
-    std::string head = fmt::format("    {} ({} {}{}): ", group.why, n, lines ? "row" : "part", n == 1 ? "" : "s");
-    text += head + WrappedNames(group.names, head.size(), 6) + "\n";
+    // "    <rule>, 3 parts: C1, C2, C3" when that fits a line; else the
+    // names start on the next line, and wrap there.
+    const std::string head = fmt::format("    {}, {} {}{}:", group.why, n, lines ? "row" : "part", n == 1 ? "" : "s");
+    const std::string names = WrappedNames(group.names, 6, 6);
+    const bool one_line = names.find('\n') == std::string::npos && head.size() + 1 + names.size() <= kSummaryWidth;
+    text += head + (one_line ? " " : "\n      ") + names + "\n";
   }
   if (!s.bottom.empty()) text += fmt::format("  bottom:  {}\n", s.bottom);
   return text;
@@ -509,18 +513,9 @@ void CadImporter::AddToSetup(SetupSlot& slot, const cad::FeederSpec& feeder, int
     slot.feeder_kind = cell::kFeederKindNames[static_cast<std::size_t>(feeder.kind)];
     slot.slot_kind = !feeder.is_pallet() ? "" : is_lane ? "lane" : "pocket";
     slot.slot = k;
-    slot.pick = feeder.pick;
-    if (feeder.is_pallet() && k > 0) {
-      // Pallet(n, k): column i, row j with k = (j - 1) * columns + i.
-      const int i = (k - 1) % feeder.columns, j = (k - 1) / feeder.columns;
-      const double along = feeder.columns > 1 ? static_cast<double>(i) / (feeder.columns - 1) : 0.0;
-      const double back = feeder.rows > 1 ? static_cast<double>(j) / (feeder.rows - 1) : 0.0;
-      for (std::size_t a = 0; a < 4; ++a) {
-        slot.pick[a] = Round(feeder.pick[a] + along * ((*feeder.pallet_last)[a] - feeder.pick[a]) +
-                                 back * (feeder.pallet_back.value_or(feeder.pick)[a] - feeder.pick[a]),
-                             kCadResolutionMm);
-      }
-    }
+    slot.pick = cell::PalletPickPoint(feeder.pick, feeder.pallet_last, feeder.pallet_back, feeder.columns,
+                                      feeder.rows, std::max(k, 1));
+    for (double& coordinate : slot.pick) coordinate = Round(coordinate, kCadResolutionMm);
   }
   ++slot.count;
   // A lane or a single tape gives the same parts to every board: named once.
@@ -966,7 +961,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   cycle.fixture_loc = start;
   cycle.end.loc = start;
   std::vector<int> pockets_used(feeders.size(), 0);
-  setup_ = SetupSheet{options_.program_name, options_.fixture, boards.size(), {}};
+  setup_ = SetupSheet{options_.program_name, options_.fixture, boards.size(), {}, {}};
   for (std::size_t f = 0; f < feeders.size(); ++f) {
     if (by_feeder[f].empty()) continue;
     const cad::FeederSpec& feeder = feeders[f];

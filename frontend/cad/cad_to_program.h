@@ -125,22 +125,33 @@ struct RowFate {
   std::array<double, 3> board_xyu{};  // x, y mm, u deg in the board's Local
 };
 
-// The feeder set-up sheet: which part goes in which feeder, lane or pocket
-// (backend/reports/setup_sheet.h prints it as text and CSV).
+// The feeder set-up sheet: which part goes in which feeder, lane or pocket.
+// `smtcal import` fills it from the list; `smtcal setup-sheet` from a
+// program's compile trace (backend/reports/setup_sheet.h, which prints both
+// as text and CSV).
 struct SetupSlot {
-  std::string feeder;
+  std::string feeder;       // "?" for picks the sheet cannot place at a feeder (see note)
   std::string feeder_kind;  // "tape" or "tray"
   std::string slot_kind;    // "lane", "pocket" or "" (the feeder's single pick point)
   int slot = 0;
   std::array<double, 4> pick{};              // the pick point, robot base frame
-  std::vector<std::string> designators;      // in the order they are placed (first board)
-  std::vector<std::string> values, packages; // the distinct ones, in order of appearance
-  std::size_t count = 0;                     // placements per cycle (all boards of a panel)
+  bool pick_known = true;                    // false: a Pick whose position only the run knows
+  // The parts taken from it, in the order they are placed: designators
+  // (first board of a panel; a pocket's part on a later board with it), or a
+  // program's place targets as written ("R1 + X(dx) ×3" when placed 3 times).
+  std::vector<std::string> designators;
+  // What it holds: from the list (import: the distinct ones, in order of
+  // appearance), or from the cell's feeder (a program: its package(s), the
+  // lane's own on a bank with one package per lane, and its value).
+  std::vector<std::string> values, packages;
+  std::size_t count = 0;  // picks per cycle (all boards of a panel)
+  std::string note;       // why a row is special ("" for most)
 };
 struct SetupSheet {
   std::string program;  // the program's name
-  std::string fixture;
+  std::string fixture;  // the fixture(s) its cycles are on
   std::size_t boards = 1;
+  std::string from;     // what the counts are of: "" for an import
   std::vector<SetupSlot> slots;  // feeder by feeder in the feeder order, slots ascending
 };
 
