@@ -244,17 +244,20 @@ SetupSheet ProgramSetupSheet(const ir::Program& program, const CompileState& sta
     if (std::find(fixtures.begin(), fixtures.end(), fixture) == fixtures.end()) fixtures.push_back(fixture);
     lines.push_back(std::to_string(stmt->loc.line));
     // Each Pick counts at its slot; the Place after it is the part it gives.
-    std::optional<std::size_t> picked;
+    // (kNone: no Pick since the last Place; a plain index rather than an
+    // optional, which GCC 12 wrongly takes for uninitialized here.)
+    constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+    std::size_t picked = kNone;
     for (const TraceEvent& event : *events) {
       if (event.kind != TraceEvent::Kind::kMotion) continue;
       const Target& target = state.targets[event.target];
       if (IsPick(target, ir::PickPlaceKind::Pick)) {
         traced[event.target] = true;
         picked = builder.RowOf(event.target);
-        builder.Pick(*picked);
-      } else if (IsPick(target, ir::PickPlaceKind::Place) && picked) {
-        builder.AddPart(*picked, target.text);
-        picked.reset();
+        builder.Pick(picked);
+      } else if (IsPick(target, ir::PickPlaceKind::Place) && picked != kNone) {
+        builder.AddPart(picked, target.text);
+        picked = kNone;
       }
     }
   }
