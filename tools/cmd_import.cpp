@@ -25,6 +25,7 @@
 #include "frontend/feeders_toml.h"
 #include "frontend/input_kind.h"
 #include "tools/commands.h"
+#include "tools/feeders_option.h"
 
 namespace smtcal::tools {
 namespace {
@@ -292,15 +293,7 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::optional<cell::Cell> cell = std::move(loaded).value();
   const cell::Fixture* fixture = cell ? ChooseFixture(*cell, opt.fixture, diags) : nullptr;
   cad::FeedersFile feeders_file;
-  if (!opt.feeders.empty()) {
-    Result<std::optional<cad::FeedersFile>> file = cad::LoadFeeders(opt.feeders, sources, diags);
-    if (!file) {
-      PrintDiagnostics(diags, options);
-      options.exit_code = ReportIoError(file.error());
-      return;
-    }
-    if (file.value()) feeders_file = std::move(*file.value());
-  }
+  if (!LoadFeedersOption(opt.feeders, sources, diags, feeders_file, options)) return;
   if (fixture != nullptr && !opt.place_z_mm && !fixture->place_z_mm) {
     diags.Report(DiagKind::ImportNoPlaceZ, fixture->name_range, fixture->name);
   }

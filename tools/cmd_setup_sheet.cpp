@@ -9,6 +9,7 @@
 #include "frontend/feeders_toml.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
+#include "tools/feeders_option.h"
 #include "tools/compile_pipeline.h"
 
 namespace smtcal::tools {
@@ -37,15 +38,7 @@ void RunSetupSheet(const SetupSheetOptions& opt, GlobalOptions& options) {
   CompiledProgram compiled;
   if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
   cad::FeedersFile feeders_file;
-  if (!opt.feeders.empty()) {
-    Result<std::optional<cad::FeedersFile>> file = cad::LoadFeeders(opt.feeders, sources, diags);
-    if (!file) {
-      PrintDiagnostics(diags, options);
-      options.exit_code = ReportIoError(file.error());
-      return;
-    }
-    if (file.value()) feeders_file = std::move(*file.value());
-  }
+  if (!LoadFeedersOption(opt.feeders, sources, diags, feeders_file, options)) return;
   std::optional<cad::FeederTable> feeders =
       cad::FeederTable::Build(compiled.cell->feeders, std::move(feeders_file), diags);
   std::optional<SetupSheet> sheet;

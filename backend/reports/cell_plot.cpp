@@ -95,6 +95,90 @@ std::array<Eigen::Vector2d, 4> PocketCorners(const cell::Fixture& fixture) {
   return {ToBase(fix, {x.lo, y.lo}), ToBase(fix, {x.hi, y.lo}), ToBase(fix, {x.hi, y.hi}), ToBase(fix, {x.lo, y.hi})};
 }
 
+// A name to write beside a mark of the picture (px). Labels are placed
+// after every mark of a panel is drawn, so none covers a mark or another
+// label: each tries places around its mark, nearest first (its preferred
+// side first), and is drawn with a thin leader line when it had to move
+// away; one that finds no room is left out and counted (the panel says how
+// many).
+struct Label {
+  std::string text;
+  double x = 0, y = 0;  // the mark, px
+  double font = 9;
+  std::string_view color = "#000";
+  int prefer = 0;       // index into kDirections: the side it is tried on first
+  double gap = 3;       // px between the mark and the text
+};
+
+struct Rect {
+  double x0, y0, x1, y1;
+  bool Overlaps(const Rect& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+  bool Inside(const Rect& o) const { return x0 >= o.x0 && x1 <= o.x1 && y0 >= o.y0 && y1 <= o.y1; }
+};
+
+// Right, left, above, below, then the diagonals (screen directions, y down).
+constexpr std::array<std::array<int, 2>, 8> kDirections = {
+    {{1, 0}, {-1, 0}, {0, -1}, {0, 1}, {1, -1}, {-1, -1}, {1, 1}, {-1, 1}}};
+constexpr int kSideRight = 0, kSideLeft = 1, kSideAbove = 2, kSideBelow = 3, kSideBelowRight = 6;
+
+class LabelPlacer {
+ public:
+  explicit LabelPlacer(const Rect& area) : area_(area) {}
+
+  // A mark labels must not cover (a square of half side `half` around x, y).
+  void Block(double x, double y, double half) { taken_.push_back({x - half, y - half, x + half, y + half}); }
+  void Add(Label label) { labels_.push_back(std::move(label)); }
+
+  // Places the labels in the order they were added; returns how many found
+  // no room.
+  int Draw(std::string& svg) {
+    int left_out = 0;
+    for (const Label& label : labels_) {
+      // A mark outside the panel (clipped away) is not named here.
+      if (label.x < area_.x0 || label.x > area_.x1 || label.y < area_.y0 || label.y > area_.y1) continue;
+      // Text extent: a generous average glyph width of a sans-serif face.
+      const double w = 0.6 * label.font * static_cast<double>(Utf8Columns(label.text)), h = label.font;
+      bool placed = false;
+      for (double ring : {0.0, 6.0, 14.0, 26.0, 40.0}) {
+        for (std::size_t i = 0; i < kDirections.size() && !placed; ++i) {
+          const auto& [ux, uy] = kDirections[(static_cast<std::size_t>(label.prefer) + i) % kDirections.size()];
+          const double r = label.gap + ring;
+          const double cx = label.x + ux * (r + w / 2), cy = label.y + uy * (r + h / 2);
+          const Rect box{cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2};
+          if (!box.Inside(area_) ||
+              std::any_of(taken_.begin(), taken_.end(), [&](const Rect& t) { return t.Overlaps(box); })) {
+            continue;
+          }
+          taken_.push_back(box);
+          if (ring > 0) {
+            const double px = std::clamp(label.x, box.x0, box.x1), py = std::clamp(label.y, box.y0, box.y1);
+            svg += fmt::format("    <line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"#888\" stroke-width=\"0.5\"/>\n",
+                               Num(label.x), Num(label.y), Num(px), Num(py));
+          }
+          svg += fmt::format(
+              "    <text x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{}\" stroke=\"white\" stroke-width=\"2\" "
+              "paint-order=\"stroke\">{}</text>\n",
+              Num(box.x0), Num(cy + 0.35 * h), Num(label.font), label.color, SvgEscape(label.text));
+          placed = true;
+        }
+        if (placed) break;
+      }
+      if (!placed) ++left_out;
+    }
+    return left_out;
+  }
+
+ private:
+  static std::size_t Utf8Columns(const std::string& text) {
+    std::size_t n = 0;
+    for (char c : text) n += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
+    return n;
+  }
+  Rect area_;
+  std::vector<Rect> taken_;
+  std::vector<Label> labels_;
+};
+
 class CellPainter {
  public:
   CellPainter(const cell::Cell& cell, const std::vector<PlottedTarget>& targets) : cell_(cell), targets_(targets) {}
@@ -129,15 +213,18 @@ class CellPainter {
   }
 
   // Everything, into one panel; `detail` numbers trips and lanes and names
-  // the placements (the close-ups).
-  void Draw(std::string& svg, const View& view, const std::string& clip, bool detail) const {
+  // the placements (the close-ups). Returns how many names found no room.
+  int Draw(std::string& svg, const View& view, const std::string& clip, bool detail) const {
     svg += fmt::format("  <g clip-path=\"url(#{})\">\n", clip);
+    LabelPlacer labels({view.left + 2, view.top + 2, view.left + view.width() - 2, view.top + view.height() - 2});
     DrawTravel(svg, view);
-    DrawRegions(svg, view, detail);
-    for (std::size_t f = 0; f < cell_.fixtures.size(); ++f) DrawFixture(svg, view, cell_.fixtures[f], detail);
-    DrawFeeders(svg, view, detail);
-    DrawTargets(svg, view, detail);
+    DrawRegions(svg, view, detail, labels);
+    for (std::size_t f = 0; f < cell_.fixtures.size(); ++f) DrawFixture(svg, view, cell_.fixtures[f], detail, labels);
+    DrawFeeders(svg, view, detail, labels);
+    DrawTargets(svg, view, detail, labels);
+    const int left_out = labels.Draw(svg);
     svg += "  </g>\n";
+    return left_out;
   }
 
  private:
@@ -166,7 +253,7 @@ class CellPainter {
         Num((limits[1].hi - limits[1].lo) * view.scale), kTravel);
   }
 
-  void DrawRegions(std::string& svg, const View& view, bool detail) const {
+  void DrawRegions(std::string& svg, const View& view, bool detail, LabelPlacer& labels) const {
     for (const cell::Region& region : cell_.regions) {
       svg += fmt::format(
           "    <rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"0.8\" "
@@ -179,14 +266,14 @@ class CellPainter {
           "stroke-width=\"1\"/>\n",
           Num(view.Px(region.x_mm.lo)), Num(view.Py(region.y_mm.hi)), Num((region.x_mm.hi - region.x_mm.lo) * view.scale),
           Num((region.y_mm.hi - region.y_mm.lo) * view.scale), kRegionFill, kRegion);
+      // The name inside the region's upper left corner.
       const double font = detail ? 11 : 10;
-      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{}\">{}</text>\n",
-                         Num(view.Px(region.x_mm.lo) + 3), Num(view.Py(region.y_mm.hi) + font + 1), Num(font), kRegion,
-                         SvgEscape(region.name));
+      labels.Add({region.name, view.Px(region.x_mm.lo) + 1, view.Py(region.y_mm.hi) + 1, font, kRegion, kSideBelowRight, 0});
     }
   }
 
-  void DrawFixture(std::string& svg, const View& view, const cell::Fixture& fixture, bool detail) const {
+  void DrawFixture(std::string& svg, const View& view, const cell::Fixture& fixture, bool detail,
+                   LabelPlacer& labels) const {
     const Eigen::Affine3d fix = NominalFix(fixture);
     const std::array<Eigen::Vector2d, 4> frame = FrameCorners(fixture);
     svg += fmt::format("    <polygon points=\"{} {} {} {}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.2\" "
@@ -197,10 +284,7 @@ class CellPainter {
       svg += fmt::format("    <polygon points=\"{} {} {} {}\" fill=\"{}\" fill-opacity=\"0.10\" stroke=\"{}\" "
                          "stroke-width=\"1.2\" stroke-dasharray=\"4 2\"/>\n",
                          view.P(pocket[0]), view.P(pocket[1]), view.P(pocket[2]), view.P(pocket[3]), kPocket, kPocket);
-      if (detail) {
-        svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"10\" fill=\"{}\">pocket</text>\n",
-                           Num(view.Px(pocket[3].x()) + 3), Num(view.Py(pocket[3].y()) + 12), kPocket);
-      }
+      if (detail) labels.Add({"pocket", view.Px(pocket[3].x()), view.Py(pocket[3].y()), 10, kPocket, kSideBelowRight, 2});
     }
     for (const auto& path : ScanPathsInBase(fixture, fix)) {
       std::string points;
@@ -209,6 +293,7 @@ class CellPainter {
                          kFixture);
       svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"2.5\" fill=\"{}\"/>\n", Num(view.Px(path.front().x())),
                          Num(view.Py(path.front().y())), kFixture);
+      labels.Block(view.Px(path.front().x()), view.Py(path.front().y()), 2.5);
     }
     for (const cell::MarkerEdge& edge : fixture.edges) {
       const Eigen::Vector2d a = ToBase(fix, edge.from), b = ToBase(fix, edge.to);
@@ -216,9 +301,7 @@ class CellPainter {
                          "stroke-linecap=\"round\"/>\n",
                          Num(view.Px(a.x())), Num(view.Py(a.y())), Num(view.Px(b.x())), Num(view.Py(b.y())), kMarker);
       if (detail) {
-        svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"9\" fill=\"{}\" text-anchor=\"middle\">{}</text>\n",
-                           Num(view.Px((a.x() + b.x()) / 2)), Num(view.Py((a.y() + b.y()) / 2) - 5), kMarker,
-                           SvgEscape(edge.name));
+        labels.Add({edge.name, view.Px((a.x() + b.x()) / 2), view.Py((a.y() + b.y()) / 2), 9, kMarker, kSideAbove, 3});
       }
     }
     const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, fix);
@@ -226,33 +309,27 @@ class CellPainter {
       const double x = view.Px(trips[k].x()), y = view.Py(trips[k].y()), r = 3;
       svg += fmt::format("    <path d=\"M{} {}L{} {}M{} {}L{} {}\" stroke=\"#000\" stroke-width=\"1.2\"/>\n", Num(x - r),
                          Num(y - r), Num(x + r), Num(y + r), Num(x - r), Num(y + r), Num(x + r), Num(y - r));
+      labels.Block(x, y, r);
     }
-    // S1 and the fixture's name; in a close-up S2, S3 and the trips too.
-    svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{}\" font-weight=\"bold\">fixture {}</text>\n",
-                       Num(view.Px(frame[0].x()) + 4), Num(view.Py(frame[0].y()) + 14), detail ? 12 : 10, kFixture,
-                       SvgEscape(fixture.name));
-    if (!detail) return;
+    // The fixture's name at S1 in the overview (a close-up's title names
+    // it); in a close-up S1, S2, S3 and the trips.
+    if (!detail) {
+      labels.Add({"fixture " + fixture.name, view.Px(frame[0].x()), view.Py(frame[0].y()), 10, kFixture, kSideBelowRight, 2});
+      return;
+    }
     const std::array<std::string_view, 4> corner_names = {"S1", "S2", "", "S3"};
+    const std::array<int, 4> corner_side = {kSideBelowRight, 7, 0, 4};  // S1, S2 below the frame; S3 above
     for (std::size_t c = 0; c < 4; ++c) {
       if (corner_names[c].empty()) continue;
-      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"10\" fill=\"{}\" text-anchor=\"{}\">{}</text>\n",
-                         Num(view.Px(frame[c].x()) + (c == 1 ? -4 : 4)), Num(view.Py(frame[c].y()) + (c == 3 ? -5 : 26)),
-                         kFixture, c == 1 ? "end" : "start", corner_names[c]);
+      labels.Add({std::string(corner_names[c]), view.Px(frame[c].x()), view.Py(frame[c].y()), 10, kFixture,
+                  corner_side[c], 3});
     }
-    // Trip names, placed off the trip across its leg, alternating sides so
-    // two trips on one marker stay apart.
-    const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
     for (std::size_t k = 0; k < trips.size(); ++k) {
-      const Eigen::Vector2d leg = fix.linear().topLeftCorner<2, 2>() * expected[k].leg_direction;
-      Eigen::Vector2d across(-leg.y(), leg.x());
-      if (k % 2 == 1) across = -across;
-      const double x = view.Px(trips[k].x()) + 14 * across.x(), y = view.Py(trips[k].y()) - 14 * across.y() + 3;
-      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"9\" text-anchor=\"middle\">{}</text>\n", Num(x), Num(y),
-                         TripName(k));
+      labels.Add({TripName(k), view.Px(trips[k].x()), view.Py(trips[k].y()), 9, "#000", k % 2 == 0 ? kSideRight : kSideLeft, 4});
     }
   }
 
-  void DrawFeeders(std::string& svg, const View& view, bool detail) const {
+  void DrawFeeders(std::string& svg, const View& view, bool detail, LabelPlacer& labels) const {
     for (const cell::Feeder& feeder : cell_.feeders) {
       const std::vector<Eigen::Vector2d> points = PickPoints(feeder);
       const double half = detail ? 3.5 : 2.5;
@@ -262,32 +339,28 @@ class CellPainter {
         box.Add(points[k]);
         svg += fmt::format("    <rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\"/>\n", Num(x - half),
                            Num(y - half), Num(2 * half), Num(2 * half), kFeeder);
-        if (detail && points.size() > 1) {
-          svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"9\" text-anchor=\"middle\">{}</text>\n", Num(x),
-                             Num(y + half + 10), k + 1);
-        }
+        labels.Block(x, y, half);
+        if (detail && points.size() > 1) labels.Add({std::to_string(k + 1), x, y, 9, "#000", kSideBelow, half + 1});
       }
       const std::string kind = feeder.kind == cell::FeederKind::kTray ? "tray" : points.size() > 1 ? "tapes" : "tape";
-      svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{}\">{}{}</text>\n",
-                         Num(view.Px(box.x0) - half), Num(view.Py(box.y1) - half - 4), detail ? 11 : 10, kFeeder,
-                         SvgEscape(feeder.name),
-                         detail ? fmt::format(" ({} {}, {})", points.size(), kind,
-                                              feeder.kind == cell::FeederKind::kTray ? "pockets 1.." + std::to_string(points.size())
-                                                                                     : "lanes 1.." + std::to_string(points.size()))
-                                : std::string());
+      const std::string slots = feeder.kind == cell::FeederKind::kTray ? "pockets" : "lanes";
+      const std::string name =
+          detail && points.size() > 1
+              ? fmt::format("{} ({} {}, {} 1..{})", feeder.name, points.size(), kind, slots, points.size())
+              : feeder.name;
+      // Above the feeder's upper left pick point.
+      labels.Add({name, view.Px(box.x0) - half, view.Py(box.y1) - half, detail ? 11.0 : 10.0, kFeeder, 4, 2});
     }
   }
 
-  void DrawTargets(std::string& svg, const View& view, bool detail) const {
+  void DrawTargets(std::string& svg, const View& view, bool detail, LabelPlacer& labels) const {
     for (const PlottedTarget& target : targets_) {
       if (!target.place) continue;
       const double x = view.Px(target.x_mm), y = view.Py(target.y_mm);
       svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{}\"/>\n", Num(x), Num(y), detail ? 2.2 : 1.6,
                          kPlace);
-      if (detail) {
-        svg += fmt::format("    <text x=\"{}\" y=\"{}\" font-size=\"7\" fill=\"#333\">{}</text>\n", Num(x + 3),
-                           Num(y - 2), SvgEscape(target.name));
-      }
+      labels.Block(x, y, detail ? 2.2 : 1.6);
+      if (detail) labels.Add({target.name, x, y, 7, "#333", kSideRight, 3});
     }
   }
 
@@ -433,8 +506,14 @@ std::string PlotCellSvg(const cell::Cell& cell, std::string_view title, std::str
     svg += fmt::format("  <!-- panel: {} -->\n", SvgEscape(panel.title));
     svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{}</text>\n",
                        Num(panel.view.left), Num(panel.view.top - 10), SvgEscape(panel.title));
-    painter.Draw(svg, panel.view, fmt::format("panel{}", p), panel.detail);
+    const int left_out = painter.Draw(svg, panel.view, fmt::format("panel{}", p), panel.detail);
     DrawAxes(svg, panel.view);
+    if (left_out > 0) {
+      svg += fmt::format("  <text x=\"{}\" y=\"{}\" text-anchor=\"end\" font-size=\"11\" fill=\"#333\">{} name{} left "
+                         "out: no room beside {} mark</text>\n",
+                         Num(panel.view.left + panel.view.width()), Num(panel.view.top + panel.view.height() + 62),
+                         left_out, left_out == 1 ? "" : "s", left_out == 1 ? "its" : "their");
+    }
   }
   DrawLegend(svg, kLeft + kPanelWidth + 40, panels.front().view.top + 4, !targets.empty());
   svg += "</svg>\n";
