@@ -304,4 +304,17 @@ Status WriteFileAtomically(const std::string& path, std::string_view contents) {
   return staged.value().Commit();
 }
 
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<StagedOutput> staged;
+  for (const auto& [path, contents] : outputs) {
+    Result<StagedOutput> stage = StagedOutput::Stage(path, contents);
+    if (!stage) return stage.error();
+    staged.push_back(std::move(stage).value());
+  }
+  for (StagedOutput& output : staged) {
+    if (Status committed = output.Commit(); !committed) return committed;
+  }
+  return Ok{};
+}
+
 }  // namespace smtcal

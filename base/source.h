@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "base/result.h"
@@ -111,5 +112,8 @@ Status WriteToStdout(std::string_view text);
 
 // Stage and Commit in one: a failure never leaves a half-written output.
 Status WriteFileAtomically(const std::string& path, std::string_view contents);
+// Several outputs (path, contents), all or none: every one is staged before
+// any is committed.
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 }  // namespace smtcal

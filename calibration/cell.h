@@ -199,6 +199,13 @@ struct Fixture {
   // import asks for --place-z instead of guessing.
   std::optional<double> place_z_mm;
   SourceRange place_z_range;  // the place_z_mm key
+  // The pocket boards sit in (pocket_x_mm, pocket_y_mm: x and y intervals in
+  // the fixture frame): `smtcal import` puts a board's outline, turned over
+  // for its bottom side, into the pocket's lower left corner, so the top and
+  // the bottom of one board are placed where the board really lies. Absent:
+  // import centres the board on a calibrated region instead.
+  std::optional<std::array<Interval, 2>> pocket_mm;
+  SourceRange pocket_range;  // the pocket_x_mm key
   SourceRange range;  // the [[fixture]] table
 };
 
@@ -230,7 +237,21 @@ struct Feeder {
   FeederKind kind = FeederKind::kTape;
   SourceRange kind_range;  // the kind key (the [[feeder]] table when absent)
   SourceRange range;  // the [[feeder]] table
+
+  int pick_points() const { return columns * rows; }  // 1 without a pallet
+  // Pick point k (1-based, PalletPickPoint's order).
+  std::array<double, 4> PickPoint(int k) const;
 };
+
+// Pick point k (1 .. columns * rows) of a pallet, in the order of the
+// language's Pallet(n, k): along the first row from `first` to `last`, then
+// row after row toward `back` (the first column of the last row; `first`
+// when absent). Without `last` (one pick point) it is `first`. The cell's
+// feeders, the feeders file's and the picture of the cell all use it.
+std::array<double, 4> PalletPickPoint(const std::array<double, 4>& first,
+                                      const std::optional<std::array<double, 4>>& last,
+                                      const std::optional<std::array<double, 4>>& back, int columns, int rows,
+                                      int k);
 
 // [linuxcnc]: how the cell's LinuxCNC controller is wired, for
 // `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that

@@ -35,6 +35,8 @@ std::string FormatMm(double mm) {
   return fmt::format("{}", mm);
 }
 
+std::string FormatComputedMm(double mm) { return FormatMm(std::round(mm * 1e6) / 1e6); }
+
 SourceRange AxisTable::Origin(std::size_t i, std::size_t j) const {
   return origin.empty() ? SourceRange() : origin[Index(i, j)];
 }

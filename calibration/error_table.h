@@ -30,6 +30,9 @@ std::string_view AxisName(TableAxis axis);  // "x" or "y"
 // A length for messages and written tables: 3 decimals when that reads back
 // exactly (150.004), else 6 when that does, else the shortest round-trip form.
 std::string FormatMm(double mm);
+// A computed position for messages: rounded to 1 nm first, so the noise of
+// arithmetic (138 + 234.21 = 372.21000000000004) does not show.
+std::string FormatComputedMm(double mm);
 
 // What a row of a table or raw measurement file is (its optional `kind`
 // column): a reading at a grid node (the default), or a check point, a

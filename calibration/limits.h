@@ -70,6 +70,8 @@ inline constexpr NumberRange kDwellS = Closed(0, 3600, "s");
 inline constexpr NumberRange kTimeoutS = AboveZero(3600, "s");
 // A fixture's trip window and its check limits.
 inline constexpr NumberRange kTripWindowMm = AboveZero(100, "mm");
+// A fixture's pocket (pocket_x_mm, pocket_y_mm): bounds in the fixture frame.
+inline constexpr NumberRange kPocketMm = Closed(-2000, 2000, "mm");
 inline constexpr NumberRange kFixtureLimitMm = AboveZero(100, "mm");
 inline constexpr NumberRange kFixtureRotationDeg = AboveZero(180, "deg");
 inline constexpr NumberRange kSquarenessDeg = AboveZero(45, "deg");

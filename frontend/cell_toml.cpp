@@ -184,6 +184,7 @@ class Loader {
   // Robot-limit checks; `robot_ok_` says whether [robot] was read cleanly.
   void CheckInLimit(int axis, double value, SourceRange where, const std::string& subject);
   void CheckPointInLimits(const std::array<double, 4>& point, SourceRange where, const std::string& subject);
+  void ReadPocket(Keys& keys, Fixture& fixture);
 
   SourceManager& sources_;
   Diagnostics& diags_;
@@ -541,7 +542,10 @@ void Loader::CheckInLimit(int axis, double value, SourceRange where, const std::
   if (!robot_ok_) return;
   const Interval& limit = robot_.limits[static_cast<std::size_t>(axis)];
   if (limit.Contains(value)) return;
-  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where, fmt::format("{} = {}", subject, Num(value)),
+  // Computed points (a scan path at the nominal pose, a pallet's far corner)
+  // are shown to 1 nm, without the noise of their arithmetic.
+  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where,
+                                   fmt::format("{} = {}", subject, Num(std::round(value * 1e6) / 1e6)),
                                    kTaskAxisNames[static_cast<std::size_t>(axis)], Num(limit.lo), Num(limit.hi),
                                    kLimitUnits[static_cast<std::size_t>(axis)]);
   Diagnostics::AddNote(diag, robot_.limit_keys[static_cast<std::size_t>(axis)],
@@ -907,6 +911,24 @@ void Loader::CheckTeachTrips(const Fixture& fixture) {
   }
 }
 
+// pocket_x_mm, pocket_y_mm: where `smtcal import` puts boards on this
+// fixture (docs/cell.md). Both or neither; each [lo, hi] within
+// limits::kPocketMm of the fixture origin.
+void Loader::ReadPocket(Keys& keys, Fixture& fixture) {
+  std::optional<Located<Interval>> x = IntervalAt(keys, "pocket_x_mm", Need::kOptional, limits::kPocketMm);
+  std::optional<Located<Interval>> y = IntervalAt(keys, "pocket_y_mm", Need::kOptional, limits::kPocketMm);
+  const bool has_x = keys.Get("pocket_x_mm") != nullptr, has_y = keys.Get("pocket_y_mm") != nullptr;
+  if (has_x != has_y) {
+    diags_.Report(DiagKind::CellMissingKey, keys.KeyRange(has_x ? "pocket_x_mm" : "pocket_y_mm"), keys.what(),
+                  has_x ? "pocket_y_mm" : "pocket_x_mm",
+                  "a pocket is a rectangle, pocket_x_mm = [lo, hi] and pocket_y_mm = [lo, hi] in the fixture frame");
+    return;
+  }
+  if (!x || !y) return;
+  fixture.pocket_mm = std::array<Interval, 2>{x->value, y->value};
+  fixture.pocket_range = x->range;
+}
+
 std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
                                            std::vector<Located<std::string>>& names) {
   const std::size_t errors_before = diags_.error_count();
@@ -939,6 +961,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
     fixture.place_z_mm = place_z->value;
     fixture.place_z_range = keys.KeyRange("place_z_mm");
   }
+  ReadPocket(keys, fixture);
   fixture.scan_speed_mm_s = NumberIn(keys, "scan_speed_mm_s", limits::kSpeedMmS).value_or(0);
   std::optional<double> window = NumberIn(keys, "trip_window_mm", limits::kTripWindowMm);
   fixture.trip_window_mm = window.value_or(0);

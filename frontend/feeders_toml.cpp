@@ -95,6 +95,24 @@ class Reader {
     return value + 0.0;  // -0 as 0
   }
 
+  // A string or a non-empty array of strings; empty when the key is absent
+  // (or wrong, which is reported).
+  std::vector<std::string> Patterns(const toml::table& table, std::string_view key, std::string_view expected) {
+    std::vector<std::string> patterns;
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return patterns;
+    if (node->is_string()) {
+      patterns.push_back(*node->value<std::string>());
+    } else if (const toml::array* list = node->as_array();
+               list != nullptr && !list->empty() &&
+               std::all_of(list->begin(), list->end(), [](const toml::node& n) { return n.is_string(); })) {
+      for (const toml::node& item : *list) patterns.push_back(*item.value<std::string>());
+    } else {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, expected, TomlTypeName(*node));
+    }
+    return patterns;
+  }
+
   std::optional<double> Number(const toml::table& table, std::string_view key, const NumberRange& range) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
@@ -150,18 +168,7 @@ class Reader {
     if (!table.contains("name")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'name'");
     if (std::optional<std::array<double, 4>> pick = Point(table, "pick")) feeder.pick = *pick;
     if (!table.contains("pick")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'pick'");
-    if (const toml::node* package = table.get("package")) {
-      if (package->is_string()) {
-        feeder.packages.push_back(*package->value<std::string>());
-      } else if (const toml::array* list = package->as_array();
-                 list != nullptr && !list->empty() &&
-                 std::all_of(list->begin(), list->end(), [](const toml::node& n) { return n.is_string(); })) {
-        for (const toml::node& item : *list) feeder.packages.push_back(*item.value<std::string>());
-      } else {
-        diags_.Report(DiagKind::FeedersWrongType, Range(*package), "package",
-                      "a package name or an array of package names", TomlTypeName(*package));
-      }
-    }
+    feeder.packages = Patterns(table, "package", "a package name or an array of package names");
     if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
     feeder.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
     if (const toml::node* node = table.get("pallet")) {
@@ -206,9 +213,9 @@ class Reader {
     CheckKeys(table, "[[map]]", {"feeder", "lane", "package", "value", "designator", "rotation_offset_deg"});
     if (std::optional<std::string> feeder = String(table, "feeder", &rule.feeder_range)) rule.feeder = *feeder;
     if (!table.contains("feeder")) diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]", "'feeder'");
-    rule.package = String(table, "package").value_or("");
-    rule.value = String(table, "value").value_or("");
-    rule.designator = String(table, "designator").value_or("");
+    rule.packages = Patterns(table, "package", "a package (a chip size or a glob) or an array of them");
+    rule.values = Patterns(table, "value", "a value (a glob) or an array of them");
+    rule.designators = Patterns(table, "designator", "a designator (a glob) or an array of them");
     if (!table.contains("package") && !table.contains("value") && !table.contains("designator")) {
       diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]",
                     "'package', 'value' or 'designator' to say which parts it maps");
@@ -337,9 +344,12 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
 std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
   for (std::size_t r = 0; r < rules_.size(); ++r) {
     const FeederRule& rule = rules_[r];
-    if (!rule.package.empty() && !PackageMatch(rule.package, row.package)) continue;
-    if (!rule.value.empty() && !GlobMatch(rule.value, row.value)) continue;
-    if (!rule.designator.empty() && !GlobMatch(rule.designator, row.designator)) continue;
+    auto any = [](const std::vector<std::string>& patterns, auto&& match) {
+      return patterns.empty() || std::any_of(patterns.begin(), patterns.end(), match);
+    };
+    if (!any(rule.packages, [&](const std::string& p) { return PackageMatch(p, row.package); })) continue;
+    if (!any(rule.values, [&](const std::string& p) { return GlobMatch(p, row.value); })) continue;
+    if (!any(rule.designators, [&](const std::string& p) { return GlobMatch(p, row.designator); })) continue;
     return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg};
   }
   std::optional<FeederMatch> best;

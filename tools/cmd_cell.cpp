@@ -3,14 +3,19 @@
 // it describes (text, or JSON with --json). The loading and all the checks
 // are in frontend/cell_toml.cpp; this file only wires the file, the options,
 // the summary and the exit codes.
+#include <filesystem>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "backend/reports/table_report.h"
+#include "backend/reports/cell_plot.h"
 #include "base/json_text.h"
 #include "calibration/fixture_geometry.h"
 #include "frontend/cell_toml.h"
+#include "passes/correction/compile_state.h"
 #include "tools/commands.h"
+#include "tools/compile_pipeline.h"
 
 namespace smtcal::tools {
 namespace {
@@ -84,6 +89,14 @@ std::string SummaryText(const cell::Cell& cell) {
     }
     if (!feeder.packages.empty()) line += fmt::format("; package {}", Join(feeder.packages, ", "));
     if (!feeder.value.empty()) line += fmt::format("; value {}", feeder.value);
+    const int points = feeder.columns * feeder.rows;
+    if (feeder.kind == cell::FeederKind::kTray) {
+      line += fmt::format("; a tray of {} pockets, one part each", points);
+    } else if (feeder.pallet_last && points > 1) {
+      line += static_cast<int>(feeder.packages.size()) == points
+                  ? fmt::format("; a bank of {} tapes, lane k holds the k-th package", points)
+                  : fmt::format("; a bank of {} tapes, each kind of part takes the next free lane", points);
+    }
     out += line + "\n";
   }
   return out;
@@ -180,13 +193,60 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
   if (!written) options.exit_code = ReportIoError(written.error());
 }
 
+// `smtcal cell plot CELL.toml -o FILE.svg [--program P.place]`: the cell as
+// a picture (backend/reports/cell_plot.h); with a program, its placements
+// where the correction passes put them at the fixtures' nominal poses.
+void RunPlot(const std::string& path, const std::string& output, const std::string& program_path,
+             GlobalOptions& options) {
+  if (FilesClash({{"CELL", path}, {"--program", program_path}}, {{"-o", output}})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::vector<PlottedTarget> targets;
+  std::optional<cell::Cell> cell;
+  if (program_path.empty()) {
+    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, sources, diags);
+    if (!loaded) {
+      options.exit_code = ReportIoError(loaded.error());
+      return;
+    }
+    cell = std::move(loaded).value();
+  } else {
+    CompiledProgram compiled;
+    if (!CompileForCell(program_path, path, false, sources, diags, compiled, options)) return;
+    cell = std::move(compiled.cell);
+    if (compiled.program.compile != nullptr) {
+      for (const Target& target : compiled.program.compile->targets) {
+        if (!target.known) continue;
+        targets.push_back({target.text, target.required[0], target.required[1], target.is_placement(),
+                           target.fixture});
+      }
+    }
+  }
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (!cell || options.exit_code != kExitOk) {
+    if (options.exit_code == kExitOk) options.exit_code = kExitInputError;
+    return;
+  }
+  const std::string title = std::filesystem::path(path).filename().string();
+  const std::string program = program_path.empty() ? "" : std::filesystem::path(program_path).filename().string();
+  Status written = WriteFileAtomically(output, PlotCellSvg(*cell, title, program, targets));
+  if (!written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  SayDone(options, output, fmt::format("wrote the picture {}", output));
+}
+
 }  // namespace
 
 void AddCellCommand(CLI::App& app, GlobalOptions& options) {
   static std::string path;
   static bool json = false;
   CLI::App* cell = app.add_subcommand(
-      "cell", "Check cell files (*.cell.toml): robot, calibrated regions, fixtures, feeders (docs/cell.md)");
+      "cell", "Check and draw cell files (*.cell.toml): robot, calibrated regions, fixtures, feeders (docs/cell.md)");
   cell->require_subcommand(1);
   CLI::App* check = cell->add_subcommand(
       "check", "Load a cell file and its error tables, report every mistake (exit 1), and print a summary:\n"
@@ -199,6 +259,16 @@ void AddCellCommand(CLI::App& app, GlobalOptions& options) {
       ->required();
   check->add_flag("--json", json, "print the summary as JSON instead of text");
   check->callback([&options] { RunCheck(path, json, options); });
+
+  static std::string plot_path, plot_output, plot_program;
+  CLI::App* plot = cell->add_subcommand(
+      "plot", "Draw the cell as an SVG picture: the robot's travel, the regions with their tables' extent,\n"
+              "the fixtures with markers, scan paths and nominal trips, the feeders with their lanes and\n"
+              "pockets, and with --program the program's placements (docs/cell.md)");
+  plot->add_option("CELL", plot_path, "the cell file")->required();
+  plot->add_option("-o,--output", plot_output, "the SVG file to write ('-' for stdout)")->required();
+  plot->add_option("--program", plot_program, "a .place program whose placements to draw on the fixtures");
+  plot->callback([&options] { RunPlot(plot_path, plot_output, plot_program, options); });
 }
 
 }  // namespace smtcal::tools

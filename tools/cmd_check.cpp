@@ -44,11 +44,7 @@ void AddCheckCommand(CLI::App& app, GlobalOptions& options) {
     }
     options.exit_code = PrintDiagnostics(diags, options);
     if (options.exit_code == kExitOk) {
-      const std::size_t warnings = diags.warning_count();
-      SayDone(options, "", fmt::format("{}: no errors, {}", sources.File(file.value()).name,
-                                       warnings == 0   ? std::string("no warnings")
-                                       : warnings == 1 ? std::string("1 warning")
-                                                       : fmt::format("{} warnings", warnings)));
+      SayDone(options, "", NoErrorsText(sources.File(file.value()).name, diags.warning_count()));
     }
   });
 }

@@ -13,6 +13,9 @@
 #include <fmt/core.h>
 
 #include "backend/place/place_printer.h"
+#include "backend/reports/import_report.h"
+#include "backend/reports/setup_sheet.h"
+#include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_reader.h"
@@ -22,6 +25,7 @@
 #include "frontend/feeders_toml.h"
 #include "frontend/input_kind.h"
 #include "tools/commands.h"
+#include "tools/feeders_option.h"
 
 namespace smtcal::tools {
 namespace {
@@ -40,7 +44,11 @@ struct ImportCliOptions {
   std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
-  std::string origin;  // empty: centred on the fixture's largest calibrated region (BoardSpot)
+  std::string origin;  // empty: in the fixture's pocket, else centred on its largest calibrated region (BoardSpot)
+  std::string board;   // --board W,H or X,Y,W,H: the outline in the list's coordinates
+  std::string report;       // --report FILE.json
+  std::string setup_sheet;  // --setup-sheet FILE: the feeder set-up sheet as text
+  std::string setup_csv;    // --setup-csv FILE: the same as CSV
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
@@ -93,6 +101,33 @@ CLI::Validator PairValidator() {
         return pair ? std::string() : pair.error().message;
       },
       "");
+}
+
+// "W,H" or "X,Y,W,H" -> the outline x0, y0, x1, y1, or why not. X and Y
+// are positions (limits::kPositionMm), W and H lengths (limits::kLengthMm),
+// each through the one check of base/number_range.h.
+Result<std::array<double, 4>> ParseBoard(const std::string& text) {
+  std::vector<std::string_view> parts;
+  std::string_view rest(text);
+  for (;;) {
+    const std::size_t comma = rest.find(',');
+    parts.push_back(rest.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 1);
+  }
+  if (parts.size() != 2 && parts.size() != 4) {
+    return Error{"expected W,H or X,Y,W,H in mm with no spaces, e.g. 16.6,40.1 or -5,0,50,30"};
+  }
+  const char* names[] = {"X", "Y", "W", "H"};
+  std::array<double, 4> numbers{0, 0, 0, 0};
+  const std::size_t first = 4 - parts.size();
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::size_t slot = first + k;
+    Result<double> number = ParseNumberIn(parts[k], slot < 2 ? limits::kPositionMm : limits::kLengthMm);
+    if (!number) return Error{fmt::format("{}: {}", names[slot], number.error().message)};
+    numbers[slot] = number.value();
+  }
+  return std::array<double, 4>{numbers[0], numbers[1], numbers[0] + numbers[2], numbers[1] + numbers[3]};
 }
 
 // "CxR" -> columns and rows of a panel, or why not.
@@ -210,6 +245,13 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
   std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : ParsePair(opt.origin).value();
+  if (!opt.board.empty()) import.board = ParseBoard(opt.board).value();
+  if (fixture.pocket_mm) {
+    const auto& [x, y] = *fixture.pocket_mm;
+    import.pocket = std::array<double, 4>{x.lo, y.lo, x.hi, y.hi};
+    import.pocket_range = fixture.pocket_range;
+  }
+  import.keep_fates = !opt.report.empty();
   std::array<double, 2> pitch = ParsePair(opt.pitch).value();
   import.origin_given = !opt.origin.empty();
   std::array<int, 2> panel = ParsePanel(opt.panel).value();
@@ -239,7 +281,11 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
 
 void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
-  if (FilesClash({{"LIST", opt.list}, {"--cell", opt.cell}, {"--feeders", opt.feeders}}, {{"-o", opt.output}})) {
+  if (FilesClash({{"LIST", opt.list}, {"--cell", opt.cell}, {"--feeders", opt.feeders}},
+                 {{"-o", opt.output},
+                  {"--report", opt.report},
+                  {"--setup-sheet", opt.setup_sheet},
+                  {"--setup-csv", opt.setup_csv}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -254,15 +300,7 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::optional<cell::Cell> cell = std::move(loaded).value();
   const cell::Fixture* fixture = cell ? ChooseFixture(*cell, opt.fixture, diags) : nullptr;
   cad::FeedersFile feeders_file;
-  if (!opt.feeders.empty()) {
-    Result<std::optional<cad::FeedersFile>> file = cad::LoadFeeders(opt.feeders, sources, diags);
-    if (!file) {
-      PrintDiagnostics(diags, options);
-      options.exit_code = ReportIoError(file.error());
-      return;
-    }
-    if (file.value()) feeders_file = std::move(*file.value());
-  }
+  if (!LoadFeedersOption(opt.feeders, sources, diags, feeders_file, options)) return;
   if (fixture != nullptr && !opt.place_z_mm && !fixture->place_z_mm) {
     diags.Report(DiagKind::ImportNoPlaceZ, fixture->name_range, fixture->name);
   }
@@ -295,8 +333,6 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     import.centre_spot = spot->first;
     import.centre_spot_name = spot->second;
   }
-  const bool origin_given = import.origin_given;
-  const std::string spot_name = import.centre_spot ? import.centre_spot_name : std::string();
   const std::string place_z_source =
       opt.place_z_mm ? std::string("--place-z") : fmt::format("place_z_mm of fixture {}", fixture->name);
   const double place_z = import.place_z_mm;
@@ -316,22 +352,25 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::string summary = FormatImportSummary(importer.summary());
   if (program) {
     const ImportSummary& s = importer.summary();
-    summary += fmt::format("  board:   origin ({}, {}) mm in fixture {}{}\n  place:   at z = {} mm ({})\n",
-                           s.origin_x_mm, s.origin_y_mm, fixture->name,
-                           origin_given       ? " (--origin)"
-                           : spot_name.empty() ? fmt::format(": the fixture carries no calibrated region to centre the "
-                                                             "parts on; give --origin X,Y")
-                                               : fmt::format(", the parts centred on {} (--origin X,Y to place the "
-                                                             "board elsewhere)",
-                                                             spot_name),
-                           place_z, place_z_source);
+    summary += fmt::format("  board:   outline {}\n           origin ({}, {}) mm in fixture {}: {}\n"
+                           "  place:   at z = {} mm ({})\n",
+                           s.outline, s.origin_x_mm, s.origin_y_mm, fixture->name, s.origin_how, place_z,
+                           place_z_source);
   }
   if (options.exit_code != kExitOk || !program) {
     SaySummary(summary);
     options.exit_code = kExitInputError;
     return;  // nothing half-written
   }
-  Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
+  // Every output is staged first, complete, beside its file, and then all
+  // are renamed into place: a run that cannot write one writes none.
+  std::vector<std::pair<std::string, std::string>> outputs = {{opt.output, PrintPlace(*program)}};
+  if (!opt.report.empty()) {
+    outputs.emplace_back(opt.report, ImportReportJson(importer.summary(), importer.fates(), BaseName(opt.list)));
+  }
+  if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(importer.setup_sheet()));
+  if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(importer.setup_sheet()));
+  Status written = WriteFilesAtomically(outputs);
   if (!written) {
     SaySummary(summary);
     options.exit_code = ReportIoError(written.error());
@@ -390,10 +429,24 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
                   fmt::format("X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (each {}; default: the "
-                              "parts centred\non the largest calibrated region on the fixture, else 0,0)",
+                              "board's outline\nin the fixture's pocket, else centred on its largest calibrated region, "
+                              "else 0,0)",
                               RangeText(limits::kPositionMm)))
       ->check(PairValidator())
       ->type_name("X,Y");
+  cmd->add_option("--board", opt.board,
+                  fmt::format("W,H or X,Y,W,H: the board's outline in the list's coordinates seen from the top, mm\n"
+                              "(its lower left corner X,Y, default 0,0: where KiCad's drill/place file origin is when\n"
+                              "it was put on that corner; X, Y each {}; W, H each {}); a part outside it is an error\n"
+                              "(default: the parts' bounding box)",
+                              RangeText(limits::kPositionMm), RangeText(limits::kLengthMm)))
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            Result<std::array<double, 4>> board = ParseBoard(text);
+            return board ? std::string() : board.error().message;
+          },
+          ""))
+      ->type_name("W,H");
   AddNumberOption(*cmd, "--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)",
                   limits::kAngleDeg);
   cmd->add_option("--mirror", opt.mirror,
@@ -439,6 +492,10 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
       ->check(CLI::IsMember({"signed", "positive"}))
       ->capture_default_str();
   cmd->add_option("--name", opt.name, "the program's name (default: from the output file's name)");
+  cmd->add_option("--report", opt.report, "write the import report: every row of the list and what became of it (JSON)");
+  cmd->add_option("--setup-sheet", opt.setup_sheet,
+                  "write the feeder set-up sheet, which part goes in which feeder, lane or pocket, as a text table");
+  cmd->add_option("--setup-csv", opt.setup_csv, "write the feeder set-up sheet as CSV");
   cmd->footer(
       "Every row becomes a placement or a diagnostic at its line; the summary on stderr counts rows\n"
       "read, placed and skipped by reason. Exit codes: 0 ok, 1 errors in the list, the cell or the\n"

@@ -121,6 +121,7 @@ void RunCheck(const TableOptions& opt, GlobalOptions& options) {
   options.exit_code = PrintDiagnostics(diags, options);
   const std::string text = fmt::format("between the nodes: {}\n", InterpolationText(interpolation, opt.tolerance_mm));
   if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
+  if (options.exit_code == kExitOk) SayDone(options, "", NoErrorsText(table->name, diags.warning_count()));
 }
 
 void RunStats(const TableOptions& opt, GlobalOptions& options) {
@@ -197,11 +198,10 @@ void RunPlot(const TableOptions& opt, GlobalOptions& options) {
 }
 
 void AddToleranceOption(CLI::App& command, TableOptions& opt) {
-  command
-      .add_option("--tolerance", opt.tolerance_mm,
+  AddNumberOption(command, "--tolerance", opt.tolerance_mm,
                   "the placing tolerance (mm) the interpolation error between the nodes is a share of; above "
-                  "10 % the pitch to measure at next is advised")
-      ->check(CLI::PositiveNumber)
+                  "10 % the pitch to measure at next is advised",
+                  limits::kAccuracyMm)
       ->capture_default_str();
 }
 

@@ -45,6 +45,8 @@ struct GlobalOptions {
 void SayDone(const GlobalOptions& options, const std::string& output, std::string_view what);
 // A command's summary of what it did (import's), several lines.
 void SaySummary(const std::string& text);
+// "layers.place: no errors, 2 warnings": what a check that found no error says.
+std::string NoErrorsText(std::string_view name, std::size_t warnings);
 
 // Prints the diagnostics to stderr in the chosen format. Returns
 // kExitInputError if any is an error, else kExitOk.
@@ -107,5 +109,6 @@ bool LoadCellForMeasure(const std::string& path, SourceManager& sources, Diagnos
 bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path, SourceManager& sources,
                      Diagnostics& diags, GlobalOptions& options, std::optional<cell::Cell>& cell,
                      std::optional<measure::LoadedPlan>& plan);
+void AddSetupSheetCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

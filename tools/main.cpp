@@ -98,6 +98,13 @@ void SaySummary(const std::string& text) {
   Say("Summary", "note", trimmed);
 }
 
+std::string NoErrorsText(std::string_view name, std::size_t warnings) {
+  return fmt::format("{}: no errors, {}", name,
+                     warnings == 0   ? std::string("no warnings")
+                     : warnings == 1 ? std::string("1 warning")
+                                     : fmt::format("{} warnings", warnings));
+}
+
 int ReportIoError(const Error& error) {
   Say("IoError", "error", error.message);
   return kExitIoError;
@@ -213,6 +220,7 @@ int main(int argc, char** argv) {
   AddDiffCommand(app, options);
   AddSimulateCommand(app, options);
   AddMeasureCommand(app, options);
+  AddSetupSheetCommand(app, options);
   int exit_code = Prescan(argc, argv);
   try {
     if (exit_code == kExitOk) exit_code = Run(app, argc, argv, options);

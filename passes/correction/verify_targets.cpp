@@ -100,7 +100,7 @@ class VerifyTargets final : public Pass {
     if (worst == nullptr) return;
     std::string turn_text = worst_turn == 0 ? std::string() : fmt::format(" and turns {:+}°", worst_turn);
     diags.Report(DiagKind::FixtureShiftLeavesRegion, Where(target), TargetKeyword(*target.stmt), target.text,
-                 FormatMm(target.required[0]), FormatMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
+                 FormatComputedMm(target.required[0]), FormatComputedMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
                  FormatMm(region.x_mm.hi), FormatMm(region.y_mm.lo), FormatMm(region.y_mm.hi), binding.name,
                  fmt::format("{:.3f}", std::max(0.0, worst_shift)), worst->direction, turn_text,
                  FormatMm(fixture.max_shift_mm), FormatMm(fixture.max_rotation_deg));

@@ -136,6 +136,10 @@ std::map<std::string, std::string> BaseCommands(const fs::path& scratch) {
       {"diff", fmt::format("diff {} {}", Q(kGolden / "diff/threshold_default.place"),
                            Q(kGolden / "diff/new/threshold_default.place"))},
       {"simulate", fmt::format("simulate {} --cell {} --cycles 2", program, cell)},
+      {"measure plan", fmt::format("measure plan --cell {} -o {}", Q(kExample.parent_path() / "calibrating/scratch.cell.toml"),
+                                   Q(scratch / "plan.csv"))},
+      {"measure program", fmt::format("measure program {} --cell {} -o {}", Q(kGolden / "measure-read/data/plan.csv"),
+                                      Q(kGolden / "measure-read/data/cell.toml"), Q(scratch / "measure"))},
   };
 }
 
@@ -175,6 +179,9 @@ TEST_F(Hostile, EveryNumericOptionOfEveryCommandRefusesWhatIsNotANumberInItsRang
       } else if (option.type == "X,Y") {
         for (const std::string& v : kHostile) values.push_back(v + ",0");
         values.push_back("0," + kHostile.front());
+      } else if (option.type == "W,H") {
+        for (const std::string& v : kHostile) values.push_back(v + ",10");
+        values.push_back("10," + kHostile.front());
       } else if (option.type == "CxR") {
         for (const std::string& v : kHostile) values.push_back(v + "x1");
         values.push_back("1x" + kHostile.front());
