@@ -1250,7 +1250,10 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   CheckUniqueNames(feeder_names, "feeder");
   CheckRegionOverlaps(cell.regions);
   if (diags_.error_count() != errors_before) return std::nullopt;
-  for (Region& region : cell.regions) region.interpolation = RegionInterpolation(cell.robot, region.table);
+  for (Region& region : cell.regions) {
+    // A region planned for measuring has no table yet: nothing to estimate.
+    if (region.has_table) region.interpolation = RegionInterpolation(cell.robot, region.table);
+  }
   return cell;
 }
 
