@@ -123,9 +123,21 @@ void ReportSteep(const ErrorTable& table, const TableAnalysis& analysis, Diagnos
   AddMoreCellsNote(diag, suspect, failing - 1, "is too steep", "are too steep");
 }
 
-void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {
+// Whether node (i, j) of `axis` was reported as an outlier: the warnings
+// leave it out (its slip is reported once, as what it is).
+using OutlierMask = std::array<std::vector<bool>, 2>;
+
+OutlierMask MaskOf(const ErrorTable& table, const std::vector<TableOutlier>& outliers) {
+  OutlierMask mask;
+  for (TableAxis axis : kTableAxes) mask[static_cast<int>(axis)].assign(table[axis].error_mm.size(), false);
+  for (const TableOutlier& o : outliers) mask[static_cast<int>(o.axis)][table[o.axis].Index(o.i, o.j)] = true;
+  return mask;
+}
+
+void WarnSignChanges(const ErrorTable& table, const OutlierMask& outlier, Diagnostics& diags) {
   for (TableAxis axis : kTableAxes) {
     const AxisTable& t = table[axis];
+    const std::vector<bool>& skip = outlier[static_cast<int>(axis)];
     std::size_t pairs = 0;
     std::size_t fi = 0, fj = 0, si = 0, sj = 0;
     // A node's value is "clearly of its sign" when it is farther from zero
@@ -136,6 +148,7 @@ void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {
       return std::abs(t.At(i, j)) > std::max(kSignChangeMinMm, 3 * se);
     };
     auto visit = [&](std::size_t i, std::size_t j, std::size_t i2, std::size_t j2) {
+      if (skip[t.Index(i, j)] || skip[t.Index(i2, j2)]) return;
       if (!(t.At(i, j) * t.At(i2, j2) < 0) || !clear(i, j) || !clear(i2, j2)) return;
       if (pairs++ == 0) {
         fi = i, fj = j, si = i2, sj = j2;
@@ -157,13 +170,14 @@ void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {
   }
 }
 
-void WarnOverHalfPitch(const ErrorTable& table, Diagnostics& diags) {
+void WarnOverHalfPitch(const ErrorTable& table, const OutlierMask& outlier, Diagnostics& diags) {
   for (TableAxis axis : kTableAxes) {
     const AxisTable& t = table[axis];
     std::size_t count = 0, wi = 0, wj = 0;
     double worst_ratio = 0, worst_pitch = 0;
     for (std::size_t j = 0; j < t.ny(); ++j) {
       for (std::size_t i = 0; i < t.nx(); ++i) {
+        if (outlier[static_cast<int>(axis)][t.Index(i, j)]) continue;
         double pitch = std::numeric_limits<double>::infinity();
         if (i > 0) pitch = std::min(pitch, t.xs[i] - t.xs[i - 1]);
         if (i + 1 < t.nx()) pitch = std::min(pitch, t.xs[i + 1] - t.xs[i]);
@@ -187,8 +201,8 @@ void WarnOverHalfPitch(const ErrorTable& table, Diagnostics& diags) {
   }
 }
 
-void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
-  for (const TableOutlier& outlier : FindTableOutliers(table)) {
+void ReportOutliers(const ErrorTable& table, const std::vector<TableOutlier>& outliers, Diagnostics& diags) {
+  for (const TableOutlier& outlier : outliers) {
     const AxisTable& t = table[outlier.axis];
     diags.Report(DiagKind::TableOutlierNode, t.Origin(outlier.i, outlier.j), AxisName(outlier.axis),
                  Signed(outlier.value_mm), FormatMm(t.xs[outlier.i]), FormatMm(t.ys[outlier.j]),
@@ -255,15 +269,23 @@ TableAnalysis AnalyzeTable(const ErrorTable& table) {
 
 bool ValidateErrorTable(const ErrorTable& table, Diagnostics& diags, TableWarnings warnings,
                         TableAnalysis* analysis_out) {
-  TableAnalysis analysis = AnalyzeTable(table);
   std::size_t errors_before = diags.error_count();
-  ReportOutliers(table, diags);
-  ReportFolds(table, analysis, diags);
+  const std::vector<TableOutlier> outliers = FindTableOutliers(table);
+  ReportOutliers(table, outliers, diags);
+  // The fold and slope checks look at the table with its outliers repaired:
+  // a slipped node folds the map around it, and that is the slip, reported
+  // once above. A fold that remains is a problem of its own.
+  const ErrorTable repaired = outliers.empty() ? ErrorTable() : WithOutliersRepaired(table, outliers);
+  const ErrorTable& checked = outliers.empty() ? table : repaired;
+  TableAnalysis analysis = AnalyzeTable(checked);
+  const std::size_t before_folds = diags.error_count();
+  ReportFolds(checked, analysis, diags);
   // A folding table is also steep; its fold is the message that matters.
-  if (diags.error_count() == errors_before) ReportSteep(table, analysis, diags);
+  if (diags.error_count() == before_folds) ReportSteep(checked, analysis, diags);
   if (warnings == TableWarnings::kReport) {
-    WarnSignChanges(table, diags);
-    WarnOverHalfPitch(table, diags);
+    const OutlierMask mask = MaskOf(table, outliers);
+    WarnSignChanges(table, mask, diags);
+    WarnOverHalfPitch(table, mask, diags);
   }
   bool ok = diags.error_count() == errors_before;
   if (analysis_out != nullptr) *analysis_out = std::move(analysis);
