@@ -123,6 +123,7 @@ class NeighbourCentres {
  public:
   NeighbourCentres(const std::vector<RawMeasurement>& measurements, const std::vector<NodeSummary>& nodes) {
     for (const NodeSummary& node : nodes) {
+      if (node.kind != ReadingKind::kNode) continue;  // check points lie off the grid lines
       std::vector<double> values;
       for (std::size_t k : node.rows) values.push_back(measurements[k].error_mm);
       const double centre = Median(values);
@@ -133,6 +134,7 @@ class NeighbourCentres {
   }
 
   std::optional<double> At(const NodeSummary& node) const {
+    if (node.kind != ReadingKind::kNode) return std::nullopt;
     const int axis = static_cast<int>(node.axis);
     double sum = 0;
     int count = 0;
@@ -183,6 +185,7 @@ Screened ScreenNodes(const std::vector<RawMeasurement>& measurements, const std:
     }
     const ReadingScreen screen =
         ScreenReadings(values, sets, typical[static_cast<int>(node.axis)], neighbours.At(node));
+    const std::string_view what = node.kind == ReadingKind::kNode ? "node" : "check point";
     const std::string x = FormatMm(node.x_mm), y = FormatMm(node.y_mm);
     const std::string_view axis = AxisName(node.axis);
     for (const ReadingOutlier& outlier : screen.outliers) {
@@ -191,11 +194,11 @@ Screened ScreenNodes(const std::vector<RawMeasurement>& measurements, const std:
       const std::string value = fmt::format("{:.6g}", m.error_mm);
       if (drop) {
         diags.Report(DiagKind::RawReadingLeftOut, m.error_field,
-                     fmt::format("reading {} mm (set {}, repetition {})", value, m.set, m.repetition), x, y, axis,
-                     fmt::format("the node's other readings have the median {:.6g} mm and scatter {} µm; {}?",
+                     fmt::format("reading {} mm (set {}, repetition {})", value, m.set, m.repetition), what, x, y,
+                     axis, fmt::format("the other readings there have the median {:.6g} mm and scatter {} µm; {}?",
                                  outlier.centre_mm, Um(screen.scatter_mm), SlipOrBadReading(outlier.slip)));
       } else {
-        diags.Report(DiagKind::RawReadingOutlier, m.error_field, value, m.set, m.repetition, x, y, axis,
+        diags.Report(DiagKind::RawReadingOutlier, m.error_field, value, m.set, m.repetition, what, x, y, axis,
                      fmt::format("{:.6g}", outlier.centre_mm), Um(screen.scatter_mm), SlipOrBadReading(outlier.slip));
       }
     }
@@ -210,7 +213,7 @@ Screened ScreenNodes(const std::vector<RawMeasurement>& measurements, const std:
     if (!slip.decided) {
       screened.undecided = true;
       Diagnostic* diag = diags.Report(
-          DiagKind::RawSetsDisagree, measurements[set_rows.front()].error_field, slip.set, slip.other, x, y, axis,
+          DiagKind::RawSetsDisagree, measurements[set_rows.front()].error_field, slip.set, slip.other, what, x, y, axis,
           slip.set, fmt::format("{:.6g}", slip.set_centre_mm), LineRanges(measurements, set_rows), slip.other,
           fmt::format("{:.6g}", slip.other_centre_mm), LineRanges(measurements, other_rows),
           SlipOrBadReading(slip.slip));
@@ -221,11 +224,11 @@ Screened ScreenNodes(const std::vector<RawMeasurement>& measurements, const std:
     const std::string lines = LineRanges(measurements, set_rows);
     if (drop) {
       diags.Report(DiagKind::RawReadingLeftOut, measurements[set_rows.front()].error_field,
-                   fmt::format("set {} (lines {})", slip.set, lines), x, y, axis,
+                   fmt::format("set {} (lines {})", slip.set, lines), what, x, y, axis,
                    fmt::format("its median {:.6g} mm against set {}'s {:.6g} mm; {}?", slip.set_centre_mm, slip.other,
                                slip.other_centre_mm, SlipOrBadReading(slip.slip)));
     } else {
-      diags.Report(DiagKind::RawSetSlip, measurements[set_rows.front()].error_field, slip.set, x, y, axis, lines,
+      diags.Report(DiagKind::RawSetSlip, measurements[set_rows.front()].error_field, slip.set, what, x, y, axis, lines,
                    fmt::format("{:.6g}", slip.set_centre_mm), slip.other, fmt::format("{:.6g}", slip.other_centre_mm),
                    LineRanges(measurements, other_rows), SlipOrBadReading(slip.slip));
     }
@@ -237,12 +240,13 @@ Screened ScreenNodes(const std::vector<RawMeasurement>& measurements, const std:
 
 std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measurements,
                                         Diagnostics& diags) {
-  std::map<std::tuple<int, double, double>, std::vector<std::size_t>> by_node;
-  std::map<std::tuple<int, double, double, long long, long long>, std::size_t> seen;
+  // A check point is averaged per position like a node, and kept apart.
+  std::map<std::tuple<int, int, double, double>, std::vector<std::size_t>> by_node;
+  std::map<std::tuple<int, int, double, double, long long, long long>, std::size_t> seen;
   for (std::size_t k = 0; k < measurements.size(); ++k) {
     const RawMeasurement& m = measurements[k];
-    auto [it, inserted] =
-        seen.emplace(std::make_tuple(static_cast<int>(m.axis), m.x_mm, m.y_mm, m.set, m.repetition), k);
+    auto [it, inserted] = seen.emplace(
+        std::make_tuple(static_cast<int>(m.kind), static_cast<int>(m.axis), m.x_mm, m.y_mm, m.set, m.repetition), k);
     if (!inserted) {
       const RawMeasurement& first = measurements[it->second];
       Diagnostic* diag = diags.Report(DiagKind::RawDuplicateMeasurement, m.repetition_field, m.repetition,
@@ -251,15 +255,16 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
       Diagnostics::AddNote(diag, first.repetition_field, "first given here");
       continue;
     }
-    by_node[{static_cast<int>(m.axis), m.x_mm, m.y_mm}].push_back(k);
+    by_node[{static_cast<int>(m.kind), static_cast<int>(m.axis), m.x_mm, m.y_mm}].push_back(k);
   }
 
   std::vector<NodeSummary> nodes;
   for (const auto& [key, rows] : by_node) {
     NodeSummary node;
-    node.axis = static_cast<TableAxis>(std::get<0>(key));
-    node.x_mm = std::get<1>(key);
-    node.y_mm = std::get<2>(key);
+    node.kind = static_cast<ReadingKind>(std::get<0>(key));
+    node.axis = static_cast<TableAxis>(std::get<1>(key));
+    node.x_mm = std::get<2>(key);
+    node.y_mm = std::get<3>(key);
     node.rows = rows;
     const double n = static_cast<double>(rows.size());
     double sum = 0;
@@ -319,6 +324,7 @@ std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<Ra
   for (const NodeSummary& summary : summaries) {
     const RawMeasurement& first = kept[summary.rows.front()];
     TableNode node;
+    node.kind = summary.kind;
     node.axis = summary.axis;
     node.x_mm = summary.x_mm;
     node.y_mm = summary.y_mm;

@@ -130,12 +130,19 @@ void FindInAxis(TableAxis axis, const AxisTable& t, std::vector<TableOutlier>& o
   auto local_disagreement = [&](const std::vector<double>& v, std::size_t node) {
     const std::size_t i = node % t.nx(), j = node / t.nx();
     double sum = 0;
-    for (std::size_t k = 0; k < nodes; ++k) {
-      const std::size_t ki = k % t.nx(), kj = k / t.nx();
-      const bool near = (kj == j && (ki > i ? ki - i : i - ki) <= 2) || (ki == i && (kj > j ? kj - j : j - kj) <= 2);
-      if (!near || (taken[k] && k != node)) continue;
+    auto add = [&](std::size_t ki, std::size_t kj) {
+      const std::size_t k = t.Index(ki, kj);
+      if (taken[k] && k != node) return;
       const std::optional<Prediction> p = Predicted(t, v, ki, kj);
       if (p) sum += (v[k] - p->value) * (v[k] - p->value);
+    };
+    // The node itself, then two nodes either way along its row and column.
+    add(i, j);
+    for (std::size_t d = 1; d <= 2; ++d) {
+      if (i >= d) add(i - d, j);
+      if (i + d < t.nx()) add(i + d, j);
+      if (j >= d) add(i, j - d);
+      if (j + d < t.ny()) add(i, j + d);
     }
     return sum;
   };

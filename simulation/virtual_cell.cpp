@@ -32,9 +32,8 @@ std::string_view SimModeDescription(SimMode mode) {
     case SimMode::kNone: return "no correction: commands as written, board at its nominal pose";
     case SimMode::kMeanOffset: return "task origin shifted by the region's table means (the paper's origin shift)";
     case SimMode::kTablesOnly: return "error tables only, no periphery calibration";
-    case SimMode::kPeripheryOnly:
-      return "periphery only: Eq. 4 on raw trips, no tables, no scan checks (the paper's production cell)";
-    case SimMode::kPaper: return "both, as the paper: Eq. 4 on raw trips, no scan checks, tables, Eq. 9 in commanded space";
+    case SimMode::kPeripheryOnly: return "periphery only: Eq. 4 on raw trips, no tables (the paper's production cell)";
+    case SimMode::kPaper: return "both, as the paper: Eq. 4 on raw trips, tables, Eq. 9 in commanded space";
     case SimMode::kImproved:
       return "both, improved: direct-calibrated trips, least squares, Eq. 7 in actual space, tables";
   }
@@ -44,8 +43,6 @@ std::string_view SimModeDescription(SimMode mode) {
 bool UsesPeriphery(SimMode mode) {
   return mode == SimMode::kPeripheryOnly || mode == SimMode::kPaper || mode == SimMode::kImproved;
 }
-
-bool UsesCellChecks(SimMode mode) { return mode == SimMode::kImproved; }
 
 long PlannedPlacements(const CompileState& state, const SimOptions& options) {
   long per_round = 0;  // every Cycle statement once
@@ -123,22 +120,6 @@ Eigen::Affine3d DrawBoard(const cell::Fixture& fixture, const BoardPoseModel& mo
     }
   }
   return PlanarFix(fixture.origin_mm + shift, (fixture.angle_deg + rotation_deg) * kRadPerDeg);
-}
-
-// The pose a cell without checks (the paper's) takes from a scan the cell's
-// checks failed: the estimate, whenever there is one. A missing trip leaves
-// an edge without its line and trips that define no pose leave no crossing:
-// those stop the cycle (nullopt). The trip window stops a scan before its
-// estimate, so the estimate is made here.
-std::optional<Eigen::Affine3d> UncheckedPose(const cell::Fixture& fixture, const ScanResult& scan) {
-  const ScanCheck failed = scan.FirstFailure()->check;
-  if (failed == ScanCheck::kMissingTrip || failed == ScanCheck::kDegenerate) return std::nullopt;
-  if (scan.estimate) return scan.estimate->fix;
-  std::vector<Eigen::Vector2d> trips;
-  for (const std::optional<Eigen::Vector2d>& trip : scan.trips) trips.push_back(*trip);
-  const std::optional<FixEstimate> estimate = EstimateFix(fixture, scan.expected, trips, scan.estimator);
-  if (!estimate) return std::nullopt;
-  return estimate->fix;
 }
 
 // Where the robot's real path along the commanded leg (from, to) crosses the
@@ -409,25 +390,13 @@ class Simulator {
       std::optional<Eigen::Affine3d> fix_n;
       if (UsesPeriphery(mode) && fixture != nullptr) {
         ScanResult scan = ScanFixture(*fixture, trips, ScanOptionsFor(mode, *fixture, m, plan.fixture));
-        fix_n = scan.fix;
         if (!scan.ok()) {
-          std::string check(ScanCheckName(scan.FirstFailure()->check));
-          if (!UsesCellChecks(mode)) {
-            fix_n = UncheckedPose(*fixture, scan);
-            if (fix_n) {
-              ++out.would_stop;
-              ++out.would_stop_checks[check];
-            } else if (scan.FirstFailure()->check == ScanCheck::kTripWindow) {
-              check = ScanCheckName(ScanCheck::kDegenerate);  // what stopped it here
-            }
-          }
-          if (!fix_n) {
-            ++out.faults;
-            out.faults_injected += injected ? 1 : 0;
-            ++out.fault_checks[check];
-            continue;  // the cycle stops: nothing placed
-          }
+          ++out.faults;
+          out.faults_injected += injected ? 1 : 0;
+          ++out.fault_checks[std::string(ScanCheckName(scan.FirstFailure()->check))];
+          continue;  // the cycle stops: nothing placed
         }
+        fix_n = scan.fix;
         previous_[m][static_cast<std::size_t>(plan.fixture)] = fix_n;
       }
       for (std::size_t j = 0; j < plan.placements.size(); ++j) {
