@@ -6,6 +6,7 @@
 
 #include "backend/diff/diff_report.h"
 #include "backend/diff/program_diff.h"
+#include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
 #include "frontend/parse.h"
@@ -37,12 +38,8 @@ ir::Program ParseAndCheck(std::uint32_t file, Diagnostics& diags) {
 }
 
 void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
-  if (opt.old_path == "-" && opt.new_path == "-") {
-    fmt::print(stderr, "smtcal diff: error: OLD and NEW cannot both be '-' (standard input is read once)\n");
-    options.exit_code = kExitUsageError;
-    return;
-  }
-  if (OutputOverwritesInput("--svg", opt.svg_path, {opt.old_path, opt.new_path, opt.cell_path})) {
+  if (FilesClash({{"OLD", opt.old_path}, {"NEW", opt.new_path}, {"--cell", opt.cell_path}},
+                 {{"--svg", opt.svg_path}, {"the diff", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -109,9 +106,8 @@ void AddDiffCommand(CLI::App& app, GlobalOptions& options) {
   diff->add_option("--cell", opt.cell_path,
                    "the cell file: gives the fixtures' nominal poses, so targets on a fixture are also given in the "
                    "robot base frame");
-  diff->add_option("--threshold", opt.threshold_um,
-                   "the gate: a target that moved by more than this many µm fails it")
-      ->check(CLI::NonNegativeNumber)
+  AddNumberOption(*diff, "--threshold", opt.threshold_um, "the gate: a target that moved by more than this many µm fails it",
+                  limits::kDiffThresholdUm)
       ->capture_default_str();
   diff->add_flag("--json", opt.json, "print the diff as JSON (schema in docs/diff.md) instead of text");
   diff->add_option("--svg", opt.svg_path,

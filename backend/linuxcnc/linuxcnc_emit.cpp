@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -840,7 +841,17 @@ class Emitter {
   void EmitJump(const ir::Stmt& stmt, const Position& target, const ir::Expr* limz) {
     GExpr z = limz != nullptr ? Expr(*limz) : Num(cell_.robot.safe_limz_mm);
     Line(fmt::format("G0 Z{}", z), stmt.loc);
-    Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach (docs/measure.md, "Backlash"): every target is
+      // reached by the same last move as every node of the measurement.
+      Position from = target;
+      from.xyzu[0] = fmt::format("[{} - {}]", target.xyzu[0], Num(approach->x()));
+      from.xyzu[1] = fmt::format("[{} - {}]", target.xyzu[1], Num(approach->y()));
+      Line(fmt::format("G0 {}", Axes(from, false)), stmt.loc);
+      Line(fmt::format("G0 X{} Y{}", target.xyzu[0], target.xyzu[1]), stmt.loc);
+    } else {
+      Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    }
     Line(fmt::format("G0 Z{}", target.xyzu[2]), stmt.loc);
   }
 
@@ -940,7 +951,14 @@ class Emitter {
     --indent_;
     block("o<pick_place_correct> endif");
     block("G0 Z#6");
-    block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach: the last x-y move is robot.final_approach_mm, as
+      // at every node the tables were measured at (backlash taken up alike).
+      block(fmt::format("G0 X[#2 - {}] Y[#3 - {}] {}#5", Num(approach->x()), Num(approach->y()), axis));
+      block("G0 X#2 Y#3");
+    } else {
+      block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    }
     block("G0 Z#4");
     block("o<pick_place_vacuum> if [#8 EQ 1]");
     ++indent_;
@@ -1131,6 +1149,22 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                d.target_.string(), why)};
     }
   }
+  // The temporaries of killed runs go first, as a file output's do: a
+  // folder "OUTDIR.tmp.PID" of a process that no longer runs, holding the
+  // subroutines/ folder Open() makes first (or, with --ini, only smtcal's
+  // files), and "RUNTIME.tmp.PID" holding only the runtime's files.
+  const auto remove_stale = [](const fs::path& target, const std::function<bool(const fs::path&)>& ours) {
+    const std::string prefix = target.filename().string() + ".tmp.";
+    const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    RemoveStaleTemporaries(parent.string(), prefix, [&ours](const std::string& stale) {
+      std::error_code ignored;
+      if (fs::is_directory(fs::symlink_status(stale, ignored)) && ours(fs::path(stale))) fs::remove_all(stale, ignored);
+    });
+  };
+  remove_stale(d.target_, [](const fs::path& stale) {
+    std::error_code ignored;
+    return fs::is_directory(stale / "subroutines", ignored) || NotOurOutput(stale).empty();
+  });
   if (!runtime.empty()) {
     d.runtime_ = runtime.has_filename() ? runtime : runtime.parent_path();
     d.runtime_replaces_ = fs::exists(fs::symlink_status(d.runtime_, error));
@@ -1141,6 +1175,7 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                  d.runtime_.string(), why)};
       }
     }
+    remove_stale(d.runtime_, [](const fs::path& stale) { return NotOurRuntime(stale).empty(); });
     d.runtime_temp_ = d.runtime_;
     d.runtime_temp_ += fmt::format(".tmp.{}", ::getpid());
     fs::remove_all(d.runtime_temp_, error);
@@ -1191,6 +1226,10 @@ Status LinuxCncDirectory::Commit(const LinuxCncOutput& output, const std::vector
   std::error_code error;
   Status written = main_->Commit();
   const fs::path subroutines = runtime_.empty() ? temp_ / "subroutines" : runtime_temp_;
+  for (const EmbeddedFile& file : output.more_mains) {
+    if (!written) break;
+    written = WriteText(temp_ / file.name, file.text);
+  }
   for (const EmbeddedFile& file : output.subroutines) {
     if (!written) break;
     written = WriteText(subroutines / file.name, file.text);

@@ -34,6 +34,7 @@ struct LinuxCncOutput {
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
   std::vector<EmbeddedFile> dry_run;      // OUTDIR/dry-run/ (--dry-run-probe, linuxcnc_dry_run.h), or none
   std::vector<LinuxCncIoUse> io;          // the digital inputs and outputs the program and the cell use
+  std::vector<EmbeddedFile> more_mains;   // further programs beside the main one (the measuring programs), or none
 };
 
 // Lowers the program, writing the main program's text to `main` as it is
@@ -68,7 +69,9 @@ std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view ma
 // subroutines/ and the runtime folder hold only smtcal_*.ngc, dry-run/ also
 // rs274's files, the machine files are smtcal's or LinuxCNC's tool table
 // and parameter file); anything else is refused by Open() with an Error
-// naming what is in the way.
+// naming what is in the way; the temporaries a killed smtcal left are
+// removed the next time smtcal writes the same directory (as a file output's
+// temporary is).
 class LinuxCncDirectory {
  public:
   // `runtime`: the runtime's own folder (--ini), or empty: OUTDIR/subroutines.

@@ -29,6 +29,9 @@
 #            first vacuum change: when the scan's first move began and
 #            when the first placement move left the scan (run_scenario.py
 #            measures the scan's overhead from it).
+# With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
+# every Place also records where the robot really was ("real": the model's
+# position latched in the servo thread when the valve went off).
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
 import os
@@ -72,6 +75,7 @@ def place_board(pose, sensor_models):
 
 def main():
     plan = json.load(open(os.environ["SMTCAL_SIM_PLAN"]))
+    real_pins = os.environ.get("SMTCAL_SIM_REAL_PINS", "")  # the robot model's component, when there is one
     out_path = os.environ["SMTCAL_SIM_RUN"]
     started = time.monotonic()
     record = {"cycles": [], "messages": [], "vacuum": [], "end": None, "times": {}}
@@ -95,6 +99,15 @@ def main():
         os.replace(out_path + ".tmp", out_path)
 
     stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+    reader = None
+    if real_pins:
+        import hal as hal_module
+        reader = hal_module.component("smtcal-sim-reader")
+        reader.newpin("x", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.newpin("y", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.ready()
+        hal([f"net placed-x {real_pins}.x-latched => smtcal-sim-reader.x",
+             f"net placed-y {real_pins}.y-latched => smtcal-sim-reader.y"])
 
     def wait_for(predicate, what, timeout_s=30):
         end = time.monotonic() + timeout_s
@@ -158,6 +171,10 @@ def main():
             if out == VACUUM_OUT:
                 event = {"t": now(), "on": bool(stat.dout[out]), "position": list(stat.position[:6]),
                          "velocity": stat.current_vel, "cycle": len(record["cycles"]) - 1}
+                if reader is not None and not event["on"]:
+                    # Where the modelled robot really was when the valve went
+                    # off (latched in the servo thread by run_measure.py's model).
+                    event["real"] = [reader["x"], reader["y"]]
                 record["vacuum"].append(event)
                 if cycle is not None:
                     cycle["traced"] = True  # the trace ends at the cycle's first Pick
