@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "calibration/fixture_geometry.h"
+#include "calibration/motion_time.h"
 
 namespace smtcal {
 namespace {
@@ -169,13 +170,6 @@ ProbeMove ProbeTo(double distance, double speed, double accel, double servo_peri
 }
 
 }  // namespace
-
-double MoveTime(double distance, double speed, double accel) {
-  distance = std::abs(distance);
-  if (distance == 0 || speed <= 0 || accel <= 0) return 0;
-  if (distance < speed * speed / accel) return 2 * std::sqrt(distance / accel);
-  return distance / speed + speed / accel;
-}
 
 bool ScanMeasuresPose(const cell::Fixture& fixture, const Eigen::Vector2d& shift_mm, double turn_deg,
                       std::string* why) {

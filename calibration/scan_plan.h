@@ -78,8 +78,4 @@ struct ScanTiming {
 // start is where the scan begins).
 ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from);
 
-// Time to move `distance` with a trapezoidal profile (triangular when
-// short), from rest to rest.
-double MoveTime(double distance, double speed, double accel);
-
 }  // namespace smtcal

@@ -68,7 +68,7 @@ std::string ProgramName(const ir::Program& program) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
-  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}},
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}, {"--ini", opt.ini}},
                  {{"-o", opt.output, opt.target == "linuxcnc"}, {"--report", opt.report}})) {
     options.exit_code = kExitUsageError;
     return;
@@ -241,8 +241,7 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
       return;
     }
     if (!compile_options.ini.empty() && compile_options.target != "linuxcnc") {
-      fmt::print(stderr, "smtcal: error: --ini needs --target linuxcnc\n");
-      options.exit_code = kExitUsageError;
+      options.exit_code = ReportUsageError("--ini needs --target linuxcnc");
       return;
     }
     RunCompile(compile_options, options);

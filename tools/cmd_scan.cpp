@@ -49,7 +49,7 @@ void ProgramPoints(const CompileState& state, const cell::Fixture& fixture, std:
 }
 
 void Run(const ScanReportOptions& opt, GlobalOptions& options) {
-  if (!opt.svg.empty() && OutputOverwritesInput("--svg", opt.svg, {opt.cell, opt.program})) {
+  if (FilesClash({{"--cell", opt.cell}, {"--program", opt.program}}, {{"--svg", opt.svg}, {"the report", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -83,12 +83,12 @@ void Run(const ScanReportOptions& opt, GlobalOptions& options) {
   if (fixture == nullptr) {
     std::string names;
     for (const cell::Fixture& f : cell->fixtures) names += (names.empty() ? "" : ", ") + f.name;
-    fmt::print(stderr, "smtcal: error: {}; {}\n",
-               opt.fixture.empty() ? fmt::format("the cell {} has {} fixtures: name one with --fixture", opt.cell,
-                                                 cell->fixtures.size())
-                                   : fmt::format("the cell {} has no fixture '{}'", opt.cell, opt.fixture),
-               names.empty() ? "it describes none" : "its fixtures: " + names);
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(fmt::format(
+        "{}; {}",
+        opt.fixture.empty()
+            ? fmt::format("the cell {} has {} fixtures: name one with --fixture", opt.cell, cell->fixtures.size())
+            : fmt::format("the cell {} has no fixture '{}'", opt.cell, opt.fixture),
+        names.empty() ? "it describes none" : "its fixtures: " + names));
     return;
   }
   std::vector<ScanReportPoint> points;

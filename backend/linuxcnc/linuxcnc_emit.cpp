@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -1047,6 +1046,9 @@ std::string NotOurRuntime(const fs::path& dir) {
   return "";
 }
 
+// The folder holding `path`, for RemoveStaleTemporaries.
+std::string ParentOf(const fs::path& path) { return path.has_parent_path() ? path.parent_path().string() : "."; }
+
 // Why `dir` is not an earlier smtcal output, or "" when it is.
 std::string NotOurOutput(const fs::path& dir) {
   if (!fs::is_directory(dir)) return fmt::format("'{}' exists and is not a directory", dir.string());
@@ -1153,17 +1155,12 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
   // folder "OUTDIR.tmp.PID" of a process that no longer runs, holding the
   // subroutines/ folder Open() makes first (or, with --ini, only smtcal's
   // files), and "RUNTIME.tmp.PID" holding only the runtime's files.
-  const auto remove_stale = [](const fs::path& target, const std::function<bool(const fs::path&)>& ours) {
-    const std::string prefix = target.filename().string() + ".tmp.";
-    const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    RemoveStaleTemporaries(parent.string(), prefix, [&ours](const std::string& stale) {
-      std::error_code ignored;
-      if (fs::is_directory(fs::symlink_status(stale, ignored)) && ours(fs::path(stale))) fs::remove_all(stale, ignored);
-    });
-  };
-  remove_stale(d.target_, [](const fs::path& stale) {
+  RemoveStaleTemporaries(ParentOf(d.target_), d.target_.filename().string() + ".tmp.", [](const std::string& stale) {
     std::error_code ignored;
-    return fs::is_directory(stale / "subroutines", ignored) || NotOurOutput(stale).empty();
+    if (fs::is_directory(fs::symlink_status(stale, ignored)) &&
+        (fs::is_directory(fs::path(stale) / "subroutines", ignored) || NotOurOutput(stale).empty())) {
+      fs::remove_all(stale, ignored);
+    }
   });
   if (!runtime.empty()) {
     d.runtime_ = runtime.has_filename() ? runtime : runtime.parent_path();
@@ -1175,7 +1172,12 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                  d.runtime_.string(), why)};
       }
     }
-    remove_stale(d.runtime_, [](const fs::path& stale) { return NotOurRuntime(stale).empty(); });
+    RemoveStaleTemporaries(ParentOf(d.runtime_), d.runtime_.filename().string() + ".tmp.", [](const std::string& stale) {
+      std::error_code ignored;
+      if (fs::is_directory(fs::symlink_status(stale, ignored)) && NotOurRuntime(stale).empty()) {
+        fs::remove_all(stale, ignored);
+      }
+    });
     d.runtime_temp_ = d.runtime_;
     d.runtime_temp_ += fmt::format(".tmp.{}", ::getpid());
     fs::remove_all(d.runtime_temp_, error);

@@ -86,7 +86,7 @@ class LinuxCncDirectory {
   TextOutput& main() { return *main_; }
   // Completes the main program, writes the runtime, the machine files and
   // the dry run, and swaps the directories in.
-  Status Commit(const LinuxCncOutput& output, const std::vector<LinuxCncMachineFile>& machine);
+  Status Commit(const LinuxCncOutput& output, const std::vector<LinuxCncMachineFile>& machine = {});
 
  private:
   LinuxCncDirectory() = default;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "calibration/fixture_estimation.h"
+#include "calibration/motion_time.h"
 #include "calibration/scan_plan.h"
 #include "fixture_test_cell.h"
 
