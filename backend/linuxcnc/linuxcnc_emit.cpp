@@ -385,16 +385,15 @@ class Emitter {
     // The runtime the path finds must be the one compiled with this program:
     // the same cell data and the same smtcal (LinuxCncRuntimeId).
     const std::string id = fmt::format("{}", LinuxCncRuntimeId(cell_));
-    const std::string message = fmt::format(
-        "(abort,smtcal: the runtime on this machine's SUBROUTINE_PATH is not the one {} was compiled with "
-        "[another cell or its tables; or another smtcal]: compile the program again for this machine with --ini)",
-        Sanitize(source_name_));
+    const std::string message =
+        "the runtime on SUBROUTINE_PATH is not the one this program was compiled with [another cell or its "
+        "tables; or another smtcal]: compile it again with --ini";
     const int known = NextOWord(), same = NextOWord();
     Line(fmt::format("o{} if [EXISTS[#<_smtcal_runtime_id>] EQ 0]", known), loc);
-    Line(message, loc);
+    Abort(message, loc);
     Line(fmt::format("o{} endif", known), loc);
     Line(fmt::format("o{} if [#<_smtcal_runtime_id> NE {}]", same, id), loc);
-    Line(message, loc);
+    Abort(message, loc);
     Line(fmt::format("o{} endif", same), loc);
   }
 

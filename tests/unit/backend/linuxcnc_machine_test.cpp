@@ -134,7 +134,7 @@ TEST(LinuxCncMachine, AnotherCellsRuntimeIsRefusedBeforeAnyMove) {
     fs::copy_file(entry.path(), dir / "remeasured" / entry.path().filename());
   }
   std::string table = test::ReadFileText(dir / "remeasured" / "feeders-table.csv");
-  table = std::regex_replace(table, std::regex("(\nx,[^,]*,[^,]*,)(-?[0-9.]+)"), "$1" "0.0123");
+  table = std::regex_replace(table, std::regex("(\nx,[^,]*,[^,]*,)(-?[0-9.]+)"), "$01" "0.0123");  // $01: group 1 ($10 would be group 10)
   std::ofstream(dir / "remeasured" / "feeders-table.csv", std::ios::binary) << table;
   ASSERT_EQ(Compile(kCell, "", dir / "a").exit_code, 0);
   test::SmtcalRun b = Compile(dir / "remeasured" / "paper.cell.toml", "", dir / "b");
@@ -144,8 +144,7 @@ TEST(LinuxCncMachine, AnotherCellsRuntimeIsRefusedBeforeAnyMove) {
   const fs::path ini = test::WriteRs274Ini(dir / "ini", {dir / "b" / "subroutines"});
   const test::Rs274Result rs274 = test::RunRs274(ini, dir / "a" / "layers.ngc");
   EXPECT_NE(rs274.exit_code, 0);
-  EXPECT_NE(rs274.err.find("smtcal: the runtime on this machine's SUBROUTINE_PATH is not the one layers.place was "
-                           "compiled with"),
+  EXPECT_NE(rs274.err.find("smtcal: the runtime on SUBROUTINE_PATH is not the one this program was compiled with"),
             std::string::npos)
       << rs274.err;
   for (const test::CanonMove& move : rs274.moves) ADD_FAILURE() << "moved: " << move.kind;

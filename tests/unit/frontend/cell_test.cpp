@@ -437,8 +437,16 @@ TEST_F(CellText, LatchSpeedIsTheSlowStage) {
     EXPECT_FALSE(refused.cell.has_value()) << bad;
     EXPECT_EQ(refused.count(DiagKind::CellValueOutOfRange), 1u) << bad << ": " << refused.diagnostics;
   }
-  Loaded turnaround = Load(kRobot + FixtureText(138, 40, 0, ""));
+  // The controller's turnaround per probe move: 0.025 s unless stated, 0 to 1 s.
+  EXPECT_EQ(one.cell->robot.probe_turnaround_s, 0.025);
+  Loaded turnaround = Load(kRobot + "probe_turnaround_s = 0.004\n" + FixtureText(138, 40, 0, ""));
+  ASSERT_TRUE(turnaround.cell.has_value()) << turnaround.diagnostics;
   EXPECT_EQ(turnaround.cell->robot.probe_turnaround_s, 0.004);
+  for (const char* bad : {"probe_turnaround_s = -0.01\n", "probe_turnaround_s = 2\n"}) {
+    Loaded refused = Load(kRobot + bad + FixtureText(138, 40, 0, ""));
+    EXPECT_FALSE(refused.cell.has_value()) << bad;
+    EXPECT_EQ(refused.count(DiagKind::CellValueOutOfRange), 1u) << bad << ": " << refused.diagnostics;
+  }
 }
 
 // Random nominal poses and teach-time boards near them: a teach scan is

@@ -91,7 +91,7 @@ TEST_F(LinuxCncConfig, TheExampleReadsAsWritten) {
   Result<IniFile> ini = ReadLinuxCncIni(example.string(), sources_, diags_);
   ASSERT_TRUE(ini);
   EXPECT_EQ(ini.value().Find("DISPLAY", "DISPLAY")->value, "linuxcncrsh");  // the headless file's, first
-  EXPECT_EQ(ini.value().Find("RS274NGC", "SUBROUTINE_PATH")->value, "runtime");
+  EXPECT_EQ(ini.value().Find("RS274NGC", "SUBROUTINE_PATH")->value, "runtime:measure/subroutines");
   const HalConfig hal = ReadLinuxCncHal(ini.value(), sources_, diags_);
   EXPECT_EQ(hal.num_dio, 16);
   EXPECT_TRUE(hal.connected.contains("motion.probe-input"));
