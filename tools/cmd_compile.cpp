@@ -103,7 +103,8 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
     if (folder) {
       runtime_folder = folder.value();
     } else {
-      diags.Report(DiagKind::LinuxCncSubroutinePath, ini->range, "is not set", folder.error().message);
+      diags.Report(DiagKind::LinuxCncSubroutinePath, ini->range,
+                   "name the folder smtcal writes its runtime into (e.g. SUBROUTINE_PATH = smtcal-runtime)");
     }
   }
   if (opt.target == "linuxcnc" && !diags.has_errors()) {

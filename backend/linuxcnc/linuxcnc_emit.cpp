@@ -1111,7 +1111,7 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   LinuxCncOutput output;
   output.io = std::move(emitter.io_);
   if (cell.linuxcnc) {
-    output.io.push_back({false, cell.linuxcnc->vacuum_sensor_input, "the vacuum switch (vacuum_sensor_input)",
+    output.io.push_back({false, cell.linuxcnc->vacuum_sensor_input, "vacuum_sensor_input",
                          cell.linuxcnc->range});
   }
   output.main_name = LinuxCncMainName(program_path);

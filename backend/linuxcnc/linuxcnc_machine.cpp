@@ -172,15 +172,15 @@ class Checker {
     const cell::Robot& robot = cell_.robot;
     const double most = MostTaskCycle(robot);
     const std::optional<double> cycle =
-        Value("TASK", "CYCLE_TIME", fmt::format("{} or less", Num(most)), "robot.probe_turnaround_s",
+        Value("TASK", "CYCLE_TIME", fmt::format("{:.4g} or less", most), "robot.probe_turnaround_s",
               Num(robot.probe_turnaround_s));
     if (!cycle || *cycle <= most * (1 + 1e-9)) return;
     const IniEntry* entry = ini_.Find("TASK", "CYCLE_TIME");
     Diagnostic* diag = diags_.Report(
         DiagKind::LinuxCncMachineDisagrees, entry->range, "[TASK]CYCLE_TIME", entry->value,
         "robot.probe_turnaround_s", Num(robot.probe_turnaround_s),
-        fmt::format("CYCLE_TIME = {} or less (each probe move of the scan costs the task about three cycles)",
-                    Num(most)));
+        fmt::format("CYCLE_TIME = {:.4g} or less (each probe move of the scan costs the task about three cycles)",
+                    most));
     Diagnostics::AddNote(diag, robot.range, "the scan's time (smtcal verify, smtcal scan report) assumes it");
   }
 
