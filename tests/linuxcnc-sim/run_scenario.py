@@ -92,10 +92,13 @@ SCENARIOS = {
     "good_boards": {"program": SIM, "expect": "ok",
                     "cycles": [pose(0.3, -0.2, 0.1), pose(-0.6, 0.45, -0.2), pose(-0.2, 0.4, 0.25)]},
     # The corners of the limits: S1 1.98 mm off, turned 0.495 deg; the first
-    # two move marker 2 the most (3.8 mm).
+    # two move marker 2 the most (3.8 mm). A nominal board between two
+    # corners: the cycle checks hold the change between two boards to the
+    # same limits (two opposite corners are 3.96 mm apart: cycle_shift).
     "limit_corners": {"program": SIM, "expect": "ok",
-                      "cycles": [limit_corner(0.5, MARKER2_DRIFT_DEG), limit_corner(-0.5, MARKER2_DRIFT_DEG + 180),
-                                 limit_corner(0.5, -45), limit_corner(-0.5, 135)]},
+                      "cycles": [limit_corner(0.5, MARKER2_DRIFT_DEG), pose_s1(),
+                                 limit_corner(-0.5, MARKER2_DRIFT_DEG + 180), pose_s1(),
+                                 limit_corner(0.5, -45), pose_s1(), limit_corner(-0.5, 135)]},
     "missing_board": {"program": SIM, "expect": "missing_trip", "cycles": [pose(present=False)]},
     "shifted_board": {"program": SIM, "expect": "nominal_shift", "cycles": [pose_s1(1.45, 1.45)]},
     "rotated_board": {"program": SIM, "expect": "nominal_rotation", "cycles": [pose_s1(turn_deg=-0.515)]},
@@ -517,13 +520,18 @@ def run_machine(args, scenario, work):
     """One run of LinuxCNC on the scenario's boards, checked; what it measured."""
     cell = cell_copy(work, scenario)
     program_dir = os.path.join(work, "program")
-    ini = derive_ini(work, program_dir, scenario.get("dry_run", False))
+    ini = derive_ini(work, program_dir, False)
     # Compiled against the machine's INI: it and its HAL files are checked
     # against the cell, and the runtime goes where its SUBROUTINE_PATH says.
     compiled = smtcal(["compile", scenario["program"], "--cell", cell, "--target", "linuxcnc", "--ini", ini,
                        "-o", program_dir] + (["--dry-run-probe"] if scenario.get("dry_run") else []), args.smtcal)
     if compiled.returncode != 0:
         fail("smtcal compile: " + compiled.stderr)
+    if scenario.get("dry_run"):
+        # The mistake this scenario makes: the dry-run folder put first on
+        # the machine's path after compiling (compiled against that path,
+        # smtcal would write the runtime into the dry-run folder).
+        ini = derive_ini(work, program_dir, True)
     stem = os.path.splitext(os.path.basename(scenario["program"]))[0]
     # Where the robot really puts the sensor around each marker (the cell's tables there, affine).
     model = run([args.checker, "--cell", cell, "--sensor-model"])

@@ -99,7 +99,7 @@ TEST(LinuxCncMachine, DisagreementNamesBothValuesAndWritesNothing) {
                          "MAX_VELOCITY = 800"),
             std::string::npos)
       << run.err;
-  EXPECT_NE(run.err.find("motion.digital-in-11 (the vacuum switch (vacuum_sensor_input) 11) is on no net"),
+  EXPECT_NE(run.err.find("motion.digital-in-11 (vacuum_sensor_input 11) is on no net"),
             std::string::npos)
       << run.err;
   EXPECT_FALSE(fs::exists(machine / "layers"));
