@@ -466,9 +466,10 @@ std::string ScanReportSvg(const ScanReport& report) {
                      P(kMargin), SvgEscape(fixture.name), SvgEscape(report.cell_name));
   out += fmt::format(
       "<text x=\"{}\" y=\"46\" font-size=\"12\">The scan takes {} s a cycle and captures boards within {} mm "
-      "and {} deg ({} x the limits); its error at 4 sigma is up to {} mm ({})</text>\n",
+      "and {} deg ({} x the limits);</text>\n<text x=\"{}\" y=\"60\" font-size=\"12\">its error at 4 sigma is "
+      "up to {} mm ({})</text>\n",
       P(kMargin), Fixed(report.timing.seconds, 2), Fixed(report.capture.shift_mm, 2),
-      Fixed(report.capture.rotation_deg, 3), Fixed(report.capture.factor, 2),
+      Fixed(report.capture.rotation_deg, 3), Fixed(report.capture.factor, 2), P(kMargin),
       Fixed(report.point_budget_mm.empty() ? 0 : *std::max_element(report.point_budget_mm.begin(),
                                                                    report.point_budget_mm.end()),
             4),
