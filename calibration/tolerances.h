@@ -62,7 +62,10 @@ inline constexpr double kMaxErrorPitchFraction = 0.5;
 // `table build` flags a node whose repetition scatter (pooled stddev) is above
 // median + kNoisyNodeMadFactor * 1.4826 * MAD of its axis's nodes (a robust
 // 5-sigma) and at least kNoisyNodeFloorMm (the transducers' resolution) above
-// the median, so a table of perfectly repeatable nodes does not flag noise.
+// the median, so a table of perfectly repeatable nodes does not flag noise;
+// and above the chi-square bound (at the same 5 sigma) of its own number of
+// readings against its axis's pooled scatter, so a node of two readings one
+// device step apart is not flagged where most nodes show no scatter at all.
 inline constexpr double kNoisyNodeMadFactor = 5.0;
 inline constexpr double kNoisyNodeFloorMm = 0.001;
 // ... and a node whose set means differ by more than kSetShiftFactor standard
