@@ -98,6 +98,7 @@ struct Region {
   SourceRange difficulty_range;
   std::string table_path;  // as written, relative to the cell file
   SourceRange table_range;
+  std::uint32_t table_file = 0;  // the table file's SourceManager id (0: not read from a file)
   ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
   Rect domain;             // TableDomain(table): where F is defined
   double tolerance_mm = 0;  // the task tolerance: +- this around the required position
@@ -221,6 +222,23 @@ struct LinuxCnc {
 // (motion.digital-in/out-00..63, [EMCMOT]num_dio).
 inline constexpr int kLinuxCncMaxDio = 64;
 
+// A file a cell was read from, with the SHA-256 of its bytes (base/sha256.h):
+// what a compiled program records of the cell it was compiled for, so
+// `smtcal diff` can tell whether a cell is that one (docs/diff.md).
+struct CellFile {
+  bool table = false;        // an error table (else the cell file itself)
+  std::string path;          // the cell file as given; a table as the cell file writes it
+  std::string sha256;        // 64 lowercase hex digits
+  std::vector<std::string> regions;  // a table: the regions that use it, in cell order
+};
+
+// How a compiled output records one of its cell's files, in a comment line
+// (docs/diff.md): "cell file sha256 <64 hex digits> <path>" or "table file
+// sha256 <64 hex digits> <path>". The regions are not part of it.
+std::string CellFileLine(const CellFile& file);
+// The inverse, for the text of such a comment; nullopt for anything else.
+std::optional<CellFile> ParseCellFileLine(std::string_view text);
+
 struct Cell {
   std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
   std::string path;    // the cell file as given
@@ -230,6 +248,10 @@ struct Cell {
   std::vector<Fixture> fixtures;
   std::vector<Feeder> feeders;
   std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
+  // The cell file, then each table file once, in the order the regions name
+  // them: set by the loader (and by the reader of a LinuxCNC output, from
+  // what the compile wrote there).
+  std::vector<CellFile> files;
 
   const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
   const Region* FindRegion(std::string_view name) const;    // case-insensitive
