@@ -121,9 +121,9 @@ MachinePoint MachineModel::RunTimePoint(const Eigen::Vector2d& required) const {
 MachinePoint MachineModel::AsWritten(const Eigen::Vector2d& command) const {
   MachinePoint point;
   point.ok = true;
-  point.required = command;
   point.command = command;
   point.lands = truth_corrector_.Forward(command);
+  point.required = point.lands;  // what the command was computed to reach
   return point;
 }
 

@@ -59,7 +59,7 @@ std::string DescribeBoardPose(const BoardPose& pose);
 struct MachinePoint {
   bool ok = false;
   std::string why;                                     // when not ok: why nothing is commanded
-  Eigen::Vector2d required = Eigen::Vector2d::Zero();  // where the part must go (base frame)
+  Eigen::Vector2d required = Eigen::Vector2d::Zero();  // where the part must go (base frame; as written: where it lands)
   Eigen::Vector2d command = Eigen::Vector2d::Zero();   // what the controller commands
   double angle_deg = 0;                                // added to u: the board's rotation as estimated
   Eigen::Vector2d lands = Eigen::Vector2d::Zero();     // F_truth(command)

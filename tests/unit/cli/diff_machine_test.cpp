@@ -148,6 +148,21 @@ TEST_F(DiffOnTheMachine, ACellThatChangedSinceTheCompileIsRefused) {
   EXPECT_EQ(given.err, "");
 }
 
+TEST_F(DiffOnTheMachine, ThePictureDrawsThePositionsAtTheirSpacing) {
+  SmtcalRun run = RunSmtcal("diff old.place new.place --exit-zero --svg moves.svg", dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string svg = ReadFileText(dir_ / "moves.svg");
+  EXPECT_NE(svg.find("55 commanded positions compared on the machine (as in the text report): 55 in the robot base"),
+            std::string::npos)
+      << svg;
+  // The 12 µm moves among parts about 9 mm apart: a few millimetres, not tens.
+  const std::size_t at = svg.find("is drawn ");
+  ASSERT_NE(at, std::string::npos);
+  const double drawn_mm = std::stod(svg.substr(at + 9));
+  EXPECT_GT(drawn_mm, 1.0);
+  EXPECT_LT(drawn_mm, 6.0);
+}
+
 TEST_F(DiffOnTheMachine, LinuxCncOutputsTakeNoCell) {
   SmtcalRun run = RunSmtcal("diff old new --cell remeasured/paper.cell.toml", dir_);
   EXPECT_EQ(run.exit_code, 2);
