@@ -67,8 +67,37 @@ std::optional<CellFile> ParseCellFileLine(std::string_view text) {
   return file;
 }
 
+std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot) {
+  if (!robot.uncalibrated_accuracy_mm) return std::nullopt;
+  return DeclaredRoughness{*robot.uncalibrated_accuracy_mm, robot.uncalibrated_correlation_mm};
+}
+
+InterpolationEstimate RegionInterpolation(const Robot& robot, const ErrorTable& table) {
+  return EstimateInterpolationError(table, DeclaredRoughnessOf(robot), robot.repeatability_mm);
+}
+
 std::string_view EstimatorName(Estimator estimator) { return kEstimatorNames[static_cast<std::size_t>(estimator)]; }
 std::string_view TaskAxisName(TaskAxis axis) { return kTaskAxisNames[static_cast<std::size_t>(axis)]; }
 std::string_view OutsidePolicyName(OutsidePolicy policy) { return kOutsideNames[static_cast<std::size_t>(policy)]; }
+
+std::array<double, 4> PalletPickPoint(const std::array<double, 4>& first,
+                                      const std::optional<std::array<double, 4>>& last,
+                                      const std::optional<std::array<double, 4>>& back, int columns, int rows,
+                                      int k) {
+  if (!last) return first;
+  const int i = (k - 1) % columns, j = (k - 1) / columns;  // column and row, from 0
+  const double along = columns > 1 ? static_cast<double>(i) / (columns - 1) : 0.0;
+  const double down = rows > 1 ? static_cast<double>(j) / (rows - 1) : 0.0;
+  const std::array<double, 4>& toward = back ? *back : first;
+  std::array<double, 4> point{};
+  for (std::size_t a = 0; a < 4; ++a) {
+    point[a] = first[a] + along * ((*last)[a] - first[a]) + down * (toward[a] - first[a]);
+  }
+  return point;
+}
+
+std::array<double, 4> Feeder::PickPoint(int k) const {
+  return PalletPickPoint(pick, pallet_last, pallet_back, columns, rows, k);
+}
 
 }  // namespace smtcal::cell

@@ -26,6 +26,7 @@
 
 #include "base/source.h"
 #include "calibration/error_table.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 
 namespace smtcal::cell {
@@ -73,8 +74,24 @@ struct Robot {
   // its leg (LinuxCNC's servo thread: 1 ms).
   double servo_period_s = 0.001;
   SourceRange servo_period_range;  // its key (the [robot] table when absent)
+  // The final approach: every calibrated target is reached by a last straight
+  // x-y move of this vector, from target - approach to the target, so each
+  // axis's backlash is taken up the same way at every target as at every
+  // node of the measurement (docs/measure.md, "Backlash"). Unset: targets are
+  // reached straight, and `smtcal measure plan` asks for it.
+  std::optional<Eigen::Vector2d> final_approach_mm;
+  SourceRange final_approach_range;  // its key (the [robot] table when absent)
   SourceRange range;        // the [robot] table
 };
+
+// What the robot declares about the roughness of its error
+// (uncalibrated_accuracy_mm over uncalibrated_correlation_mm); nullopt when
+// it declares no accuracy.
+std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot);
+// The interpolation error of a region's table in this robot's cell: with the
+// robot's declared roughness, and a node that states no noise counted as one
+// measurement with the robot's repeatability (as the budget does).
+InterpolationEstimate RegionInterpolation(const Robot& robot, const ErrorTable& table);
 
 // The axes a region's difficulty measure names.
 enum class TaskAxis { X, Y, Z, U };
@@ -98,9 +115,17 @@ struct Region {
   SourceRange difficulty_range;
   std::string table_path;  // as written, relative to the cell file
   SourceRange table_range;
+  // Loaded and validated (ValidateErrorTable passed). Only a cell loaded for
+  // planning a measurement (CellLoadOptions) may have a region without a
+  // table yet: then has_table is false, the table and domain are empty, and
+  // the bounds are as written.
+  bool has_table = true;
   std::uint32_t table_file = 0;  // the table file's SourceManager id (0: not read from a file)
-  ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
+  ErrorTable table;
   Rect domain;             // TableDomain(table): where F is defined
+  // How far the robot's error may depart from the table's interpolation
+  // between its nodes: RegionInterpolation(robot, table), set by the loader.
+  InterpolationEstimate interpolation;
   double tolerance_mm = 0;  // the task tolerance: +- this around the required position
   SourceRange tolerance_range;
   OutsidePolicy outside = OutsidePolicy::kError;  // policy for points outside the grid
@@ -175,6 +200,13 @@ struct Fixture {
   // import asks for --place-z instead of guessing.
   std::optional<double> place_z_mm;
   SourceRange place_z_range;  // the place_z_mm key
+  // The pocket boards sit in (pocket_x_mm, pocket_y_mm: x and y intervals in
+  // the fixture frame): `smtcal import` puts a board's outline, turned over
+  // for its bottom side, into the pocket's lower left corner, so the top and
+  // the bottom of one board are placed where the board really lies. Absent:
+  // import centres the board on a calibrated region instead.
+  std::optional<std::array<Interval, 2>> pocket_mm;
+  SourceRange pocket_range;  // the pocket_x_mm key
   SourceRange range;  // the [[fixture]] table
 };
 
@@ -206,7 +238,21 @@ struct Feeder {
   FeederKind kind = FeederKind::kTape;
   SourceRange kind_range;  // the kind key (the [[feeder]] table when absent)
   SourceRange range;  // the [[feeder]] table
+
+  int pick_points() const { return columns * rows; }  // 1 without a pallet
+  // Pick point k (1-based, PalletPickPoint's order).
+  std::array<double, 4> PickPoint(int k) const;
 };
+
+// Pick point k (1 .. columns * rows) of a pallet, in the order of the
+// language's Pallet(n, k): along the first row from `first` to `last`, then
+// row after row toward `back` (the first column of the last row; `first`
+// when absent). Without `last` (one pick point) it is `first`. The cell's
+// feeders, the feeders file's and the picture of the cell all use it.
+std::array<double, 4> PalletPickPoint(const std::array<double, 4>& first,
+                                      const std::optional<std::array<double, 4>>& last,
+                                      const std::optional<std::array<double, 4>>& back, int columns, int rows,
+                                      int k);
 
 // [linuxcnc]: how the cell's LinuxCNC controller is wired, for
 // `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that
@@ -218,9 +264,74 @@ struct LinuxCnc {
   SourceRange range;             // the [linuxcnc] table
 };
 
+// [measure]: the instrument that measures the robot's error at the nodes of
+// a region (docs/measure.md, docs/cell.md). One of three devices:
+enum class MeasureDevice {
+  // The paper's (Fig. 4): a linear displacement transducer touches the flank
+  // of a groove in a precise plate the robot carries; the flank turns the
+  // robot's error along the axis into a vertical displacement, read as an
+  // analog input, and a second transducer on the plate's surface takes out
+  // the robot's z error. One axis per run (the transducer is mounted for it).
+  kTransducer,
+  // A touch probe in the gripper against a precise hole at every node (a
+  // hole plate): the probe moves from the node towards the hole's wall along
+  // each axis; the trip against the wall's calibrated position is the error.
+  kProbe,
+  // An external system (camera, CMM, laser tracker): the program triggers it
+  // at every node and waits for it; its readings come as CSV keyed by node.
+  kExternal,
+};
+inline constexpr std::array<std::string_view, 3> kMeasureDeviceNames = {"transducer", "probe", "external"};
+
+struct MeasureTransducer {
+  int input = 0;            // motion.analog-in-NN of the measuring transducer (on the groove's flank)
+  int reference_input = 1;  // motion.analog-in-NN of the z reference transducer (on the plate's surface)
+  // The reading's change per mm of the robot's error along the measured axis
+  // (the flank's slope, signed: 1 for a 45 degree flank rising with the axis).
+  double slope = 1;
+  // The measuring minus the reference reading with the robot exactly at the
+  // node (from the set-up: the plate's certificate and the zeroing gauge).
+  double zero_mm = 0;
+  Interval range_mm{0, 1};  // readings outside it: the transducer lost contact (the program aborts)
+  double groove_pitch_mm = 5;  // nodes and check points must lie on grooves: multiples of it from the first node
+  int grooves = 11;            // grooves per direction: the plate's reach
+};
+
+struct MeasureProbe {
+  double hole_diameter_mm = 0;    // the holes' calibrated diameter
+  double hole_pitch_mm = 5;       // the holes sit on a square lattice of this pitch; nodes and check points must be holes
+  double stylus_diameter_mm = 0;  // the stylus ball's effective diameter (calibrated on a ring gauge)
+  double speed_mm_s = 1;          // the probing feed
+  double overtravel_mm = 0.5;     // how far past the expected wall a probe move may go before it is a miss
+};
+
+struct MeasureExternal {
+  int trigger_output = 0;  // motion.digital-out-NN: on asks the system for a reading
+  int done_input = 0;      // motion.digital-in-NN: on when the system has taken it
+  int node_output = 0;     // motion.analog-out-NN: the node; the set and repetition on the next two
+};
+
+struct Measure {
+  MeasureDevice device = MeasureDevice::kProbe;
+  SourceRange device_range;
+  double z_mm = 0;        // the robot z at which the device reads
+  double clear_z_mm = 0;  // the z between nodes (default: the robot's safe_limz_mm)
+  double dwell_s = 0.2;   // settle time at the node before the reading
+  double noise_mm = 0;    // one standard deviation of a single reading (the device's stated noise)
+  double timeout_s = 5;   // how long the program waits for the device before it aborts
+  double reading_time_s = 0;  // the device's own time per reading (an external system's exposure), for the plan's time
+  std::optional<int> ready_input;  // motion.digital-in-NN, on while the device is ready (checked before each reading)
+  MeasureTransducer transducer;
+  MeasureProbe probe;
+  MeasureExternal external;
+  SourceRange range;  // the [measure] table
+};
+
 // LinuxCNC's motion controller has at most 64 digital inputs and outputs
 // (motion.digital-in/out-00..63, [EMCMOT]num_dio).
 inline constexpr int kLinuxCncMaxDio = 64;
+// ... and at most 64 analog inputs and outputs (motion.analog-in/out-NN, [EMCMOT]num_aio).
+inline constexpr int kLinuxCncMaxAio = 64;
 
 // A file a cell was read from, with the SHA-256 of its bytes (base/sha256.h):
 // what a compiled program records of the cell it was compiled for, so
@@ -248,6 +359,7 @@ struct Cell {
   std::vector<Fixture> fixtures;
   std::vector<Feeder> feeders;
   std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
+  std::optional<Measure> measure;    // the [measure] table, when the file has one
   // The cell file, then each table file once, in the order the regions name
   // them: set by the loader (and by the reader of a LinuxCNC output, from
   // what the compile wrote there).

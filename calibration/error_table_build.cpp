@@ -110,12 +110,13 @@ void WarnSetShifts(const std::vector<RawMeasurement>& measurements, const std::v
 
 std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measurements,
                                         Diagnostics& diags) {
-  std::map<std::tuple<int, double, double>, std::vector<std::size_t>> by_node;
-  std::map<std::tuple<int, double, double, long long, long long>, std::size_t> seen;
+  // A check point is averaged per position like a node, and kept apart.
+  std::map<std::tuple<int, int, double, double>, std::vector<std::size_t>> by_node;
+  std::map<std::tuple<int, int, double, double, long long, long long>, std::size_t> seen;
   for (std::size_t k = 0; k < measurements.size(); ++k) {
     const RawMeasurement& m = measurements[k];
-    auto [it, inserted] =
-        seen.emplace(std::make_tuple(static_cast<int>(m.axis), m.x_mm, m.y_mm, m.set, m.repetition), k);
+    auto [it, inserted] = seen.emplace(
+        std::make_tuple(static_cast<int>(m.kind), static_cast<int>(m.axis), m.x_mm, m.y_mm, m.set, m.repetition), k);
     if (!inserted) {
       const RawMeasurement& first = measurements[it->second];
       Diagnostic* diag = diags.Report(DiagKind::RawDuplicateMeasurement, m.repetition_field, m.repetition,
@@ -124,15 +125,16 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
       Diagnostics::AddNote(diag, first.repetition_field, "first given here");
       continue;
     }
-    by_node[{static_cast<int>(m.axis), m.x_mm, m.y_mm}].push_back(k);
+    by_node[{static_cast<int>(m.kind), static_cast<int>(m.axis), m.x_mm, m.y_mm}].push_back(k);
   }
 
   std::vector<NodeSummary> nodes;
   for (const auto& [key, rows] : by_node) {
     NodeSummary node;
-    node.axis = static_cast<TableAxis>(std::get<0>(key));
-    node.x_mm = std::get<1>(key);
-    node.y_mm = std::get<2>(key);
+    node.kind = static_cast<ReadingKind>(std::get<0>(key));
+    node.axis = static_cast<TableAxis>(std::get<1>(key));
+    node.x_mm = std::get<2>(key);
+    node.y_mm = std::get<3>(key);
     node.rows = rows;
     const double n = static_cast<double>(rows.size());
     double sum = 0;
@@ -182,6 +184,7 @@ std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<Ra
   for (const NodeSummary& summary : summaries) {
     const RawMeasurement& first = measurements[summary.rows.front()];
     TableNode node;
+    node.kind = summary.kind;
     node.axis = summary.axis;
     node.x_mm = summary.x_mm;
     node.y_mm = summary.y_mm;

@@ -14,8 +14,12 @@
 
 namespace smtcal {
 
-// One row of a raw measurement file: axis,x_mm,y_mm,set,repetition,error_mm.
+// One row of a raw measurement file: axis,x_mm,y_mm,set,repetition,error_mm
+// and the optional kind (node, the default, or check: a reading off the grid
+// nodes, averaged per position like a node and kept in the table as a check
+// point).
 struct RawMeasurement {
+  ReadingKind kind = ReadingKind::kNode;
   TableAxis axis = TableAxis::X;
   double x_mm = 0;
   double y_mm = 0;
@@ -28,8 +32,9 @@ struct RawMeasurement {
   SourceRange error_field;
 };
 
-// The statistics of one node's measurements.
+// The statistics of one node's (or check point's) measurements.
 struct NodeSummary {
+  ReadingKind kind = ReadingKind::kNode;
   TableAxis axis = TableAxis::X;
   double x_mm = 0, y_mm = 0;
   std::vector<std::size_t> rows;  // indices into the measurements, in file order
@@ -42,7 +47,8 @@ struct NodeSummary {
   std::optional<double> set_spread_weight;
 };
 
-// Groups measurements by node and summarizes each (sorted by axis, x, y).
+// Groups measurements by node (check points by position) and summarizes each
+// (sorted by kind, axis, x, y: the nodes first).
 // Reports a repetition given twice.
 std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measurements,
                                         Diagnostics& diags);

@@ -77,6 +77,11 @@ inline constexpr double kSetShiftFloorMm = 0.001;
 // so any larger miss is a typo or a wrong L1/L2, not a measurement error.
 inline constexpr double kMarkerGeometryTolMm = 1e-6;
 
+// The robot's final approach (robot.final_approach_mm) takes up backlash,
+// which is micrometres to a tenth of a millimetre: a longer approach is a
+// typo (or a unit mistake), and costs time at every target.
+inline constexpr double kMaxFinalApproachMm = 10;
+
 // --- CAD import ----------------------------------------------------------------
 // (frontend/cad_*.cpp, frontend/cad/cad_to_program.cpp; docs/import.md)
 
@@ -87,6 +92,13 @@ inline constexpr double kMarkerGeometryTolMm = 1e-6;
 inline constexpr double kCadResolutionMm = 1e-6;
 // Rotations after the side and offset conventions, likewise (a micro-degree).
 inline constexpr double kCadResolutionDeg = 1e-6;
+// The feeder set-up sheet of a program (backend/reports/setup_sheet.cpp)
+// finds a Pick's feeder by its pick point: the program's point (its pallet
+// corners interpolated) and the cell's are the same numbers, apart from the
+// arithmetic's rounding, when they describe the same lane. A pick farther
+// than this from every pick point of the cell is at no feeder the cell knows
+// and is reported; lanes are millimetres apart.
+inline constexpr double kFeederPickMatchMm = 0.01;
 
 // --- periphery calibration ---------------------------------------------------
 // (calibration/fixture_estimation.cpp; the C runtime runtime/c/ repeats these values

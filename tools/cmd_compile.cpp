@@ -67,8 +67,8 @@ std::string ProgramName(const ir::Program& program) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
-      OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}},
+                 {{"-o", opt.output, opt.target == "linuxcnc"}, {"--report", opt.report}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -107,9 +107,10 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   if (opt.target == "c") {
     for (const cell::Fixture& fixture : compiled.cell->fixtures) {
       if (FitsCRuntime(fixture)) continue;
-      fmt::print(stderr, "smtcal: error: the scan paths of fixture '{}' make more trips than the C runtime holds ({}, "
-                         "SMTCAL_MAX_TRIPS in runtime/c/smtcal_runtime.h)\n", fixture.name, kCRuntimeMaxTrips);
-      options.exit_code = kExitInputError;
+      options.exit_code = ReportInputError(
+          fmt::format("the scan paths of fixture '{}' make more trips than the C runtime holds ({}, "
+                      "SMTCAL_MAX_TRIPS in runtime/c/smtcal_runtime.h)",
+                      fixture.name, kCRuntimeMaxTrips));
       return;
     }
     text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ProgramName(compiled.program));
@@ -147,6 +148,10 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
 }
 
 void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}}, {})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
@@ -194,8 +199,7 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
                       "region, residual, budget) and the cycle-time estimate");
   compile->callback([&options] {
     if (compile_options.dry_run_probe && compile_options.target != "linuxcnc") {
-      fmt::print(stderr, "smtcal: error: --dry-run-probe needs --target linuxcnc\n");
-      options.exit_code = kExitUsageError;
+      options.exit_code = ReportUsageError("--dry-run-probe needs --target linuxcnc");
       return;
     }
     RunCompile(compile_options, options);

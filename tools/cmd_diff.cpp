@@ -16,6 +16,7 @@
 #include "backend/diff/diff_report.h"
 #include "backend/diff/program_diff.h"
 #include "base/sha256.h"
+#include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
 #include "frontend/linuxcnc_output.h"
@@ -196,34 +197,29 @@ void Describe(Side& side) {
 bool IsLinuxCnc(const std::string& path) { return path != "-" && LooksLikeLinuxCncOutput(path); }
 
 void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
-  if (opt.old_path == "-" && opt.new_path == "-") {
-    fmt::print(stderr, "smtcal diff: error: OLD and NEW cannot both be '-' (standard input is read once)\n");
-    options.exit_code = kExitUsageError;
-    return;
-  }
   if (!opt.cell_path.empty() && (!opt.old_cell_path.empty() || !opt.new_cell_path.empty())) {
-    fmt::print(stderr, "smtcal diff: error: give --cell (one cell for both) or --old-cell/--new-cell, not both\n");
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError("give --cell (one cell for both) or --old-cell/--new-cell, not both");
     return;
   }
   const bool linuxcnc = IsLinuxCnc(opt.old_path);
   if (linuxcnc != IsLinuxCnc(opt.new_path)) {
-    fmt::print(stderr,
-               "smtcal diff: error: {} is a LinuxCNC output and {} is not: compare two LinuxCNC outputs or two "
-               ".place programs\n",
-               linuxcnc ? opt.old_path : opt.new_path, linuxcnc ? opt.new_path : opt.old_path);
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(fmt::format(
+        "{} is a LinuxCNC output and {} is not: compare two LinuxCNC outputs or two .place programs",
+        linuxcnc ? opt.old_path : opt.new_path, linuxcnc ? opt.new_path : opt.old_path));
     return;
   }
   if (linuxcnc && (!opt.cell_path.empty() || !opt.old_cell_path.empty() || !opt.new_cell_path.empty())) {
-    fmt::print(stderr,
-               "smtcal diff: error: a LinuxCNC output carries its cell's data (subroutines/smtcal_data.ngc): leave "
-               "out --cell, --old-cell and --new-cell\n");
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(
+        "a LinuxCNC output carries its cell's data (subroutines/smtcal_data.ngc): leave out --cell, --old-cell and "
+        "--new-cell");
     return;
   }
-  if (OutputOverwritesInput("--svg", opt.svg_path,
-                            {opt.old_path, opt.new_path, opt.cell_path, opt.old_cell_path, opt.new_cell_path})) {
+  if (FilesClash({{"OLD", opt.old_path},
+                  {"NEW", opt.new_path},
+                  {"--cell", opt.cell_path},
+                  {"--old-cell", opt.old_cell_path},
+                  {"--new-cell", opt.new_cell_path}},
+                 {{"--svg", opt.svg_path}, {"the diff", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -366,9 +362,8 @@ void AddDiffCommand(CLI::App& app, GlobalOptions& options) {
                    "records); without it each compiled program is evaluated with the cell it records");
   diff->add_option("--old-cell", opt.old_cell_path, "the cell OLD was compiled for (when it is not NEW's)");
   diff->add_option("--new-cell", opt.new_cell_path, "the cell NEW was compiled for (when it is not OLD's)");
-  diff->add_option("--threshold", opt.threshold_um,
-                   "the gate: a target that moved by more than this many µm fails it")
-      ->check(CLI::NonNegativeNumber)
+  AddNumberOption(*diff, "--threshold", opt.threshold_um, "the gate: a target that moved by more than this many µm fails it",
+                  limits::kDiffThresholdUm)
       ->capture_default_str();
   diff->add_flag("--json", opt.json, "print the diff as JSON (schema in docs/diff.md) instead of text");
   diff->add_option("--svg", opt.svg_path,

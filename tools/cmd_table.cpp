@@ -10,10 +10,12 @@
 #include "backend/reports/table_report.h"
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 #include "calibration/table_diff.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
+#include "calibration/limits.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
 
@@ -23,11 +25,13 @@ namespace {
 struct TableOptions {
   std::string input;   // the table (or raw file for build)
   std::string points = "-";
+  bool points_given = false;
   std::string output = "-";
   bool json = false;
   std::string outside = "error";
   std::string solver = "default";
   double paper_tolerance_mm = kPaperSolverTolMm;
+  double tolerance_mm = kDefaultTableToleranceMm;  // check, stats: what the interpolation error is a share of
   // table diff
   std::string new_input;
   std::string cell;
@@ -37,6 +41,18 @@ struct TableOptions {
 };
 
 std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// The interpolation estimate of a table on its own: no cell, so no declared
+// roughness; a node or check point that states no noise counts as one
+// reading with the largest stddev the table states (0 when it states none).
+InterpolationEstimate TableInterpolation(const ErrorTable& table) {
+  double largest = 0;
+  for (const AxisTable& t : table.axes) {
+    for (const auto& sd : t.stddev_mm) largest = std::max(largest, sd.value_or(0.0));
+    for (const TableNode& check : t.checks) largest = std::max(largest, check.stddev_mm.value_or(0.0));
+  }
+  return EstimateInterpolationError(table, std::nullopt, largest);
+}
 
 // Loads and validates a table. Returns nullopt after setting the exit code
 // (I/O error, or input errors printed); diagnostics are printed by the caller
@@ -75,15 +91,18 @@ OutsidePolicy ParsePolicy(const std::string& name) {
   return OutsidePolicy::kError;
 }
 
-// The output options of `table` never name the command's own inputs.
-bool OutputIsInput(const TableOptions& opt, GlobalOptions& options) {
-  if (!OutputOverwritesInput("-o", opt.output, {opt.input, opt.points})) return false;
+// The files of a `table` command against each other (tools/commands.h):
+// POINTS is standard input unless given, so `table inverse -` clashes too.
+bool FilesClashIn(const TableOptions& opt, bool with_points, GlobalOptions& options) {
+  std::vector<NamedFile> inputs = {{"TABLE", opt.input}};
+  if (with_points) inputs.push_back({opt.points_given ? "POINTS" : "POINTS (standard input unless given)", opt.points});
+  if (!FilesClash(inputs, {{"-o", opt.output}})) return false;
   options.exit_code = kExitUsageError;
   return true;
 }
 
 void RunBuild(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Result<std::uint32_t> file = sources.Load(opt.input);
   if (!file) {
@@ -105,9 +124,14 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
 void RunCheck(const TableOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  if (LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
-    options.exit_code = PrintDiagnostics(diags, options);
-  }
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kReport, options);
+  if (!table) return;
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
+  ReportCoarseGrid(interpolation, opt.tolerance_mm, "the table", interpolation.Origin(), diags);
+  options.exit_code = PrintDiagnostics(diags, options);
+  const std::string text = fmt::format("between the nodes: {}\n", InterpolationText(interpolation, opt.tolerance_mm));
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
+  if (options.exit_code == kExitOk) SayDone(options, "", NoErrorsText(table->name, diags.warning_count()));
 }
 
 void RunStats(const TableOptions& opt, GlobalOptions& options) {
@@ -119,13 +143,14 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
   table->name = BaseName(table->name);
   TableStats stats = ComputeTableStats(*table);
   int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
   Finish(diags, options, "-",
-         opt.json ? FormatStatsJson(*table, stats, analysis, bound)
-                  : FormatStatsText(*table, stats, analysis, bound));
+         opt.json ? FormatStatsJson(*table, stats, analysis, bound, interpolation, opt.tolerance_mm)
+                  : FormatStatsText(*table, stats, analysis, bound, interpolation, opt.tolerance_mm));
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, true, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   TableAnalysis analysis;
@@ -174,7 +199,7 @@ void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
 }
 
 void RunPlot(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
@@ -183,12 +208,8 @@ void RunPlot(const TableOptions& opt, GlobalOptions& options) {
 }
 
 void RunDiff(const TableOptions& opt, GlobalOptions& options) {
-  if (opt.input == "-" && opt.new_input == "-") {
-    fmt::print(stderr, "smtcal table diff: error: A and B cannot both be '-' (standard input is read once)\n");
-    options.exit_code = kExitUsageError;
-    return;
-  }
-  if (OutputOverwritesInput("--svg", opt.svg, {opt.input, opt.new_input, opt.cell})) {
+  if (FilesClash({{"A", opt.input}, {"B", opt.new_input}, {"--cell", opt.cell}},
+                 {{"--svg", opt.svg}, {"the diff", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -220,8 +241,7 @@ void RunDiff(const TableOptions& opt, GlobalOptions& options) {
   if (!opt.svg.empty()) {
     const std::string svg = PlotTableDiffSvg(*old_table, *new_table, names);
     if (svg.empty()) {
-      fmt::print(stderr, "smtcal table diff: error: the tables share no area of 2 x 2 nodes to draw; no --svg written\n");
-      options.exit_code = kExitInputError;
+      options.exit_code = ReportInputError("the tables share no area of 2 x 2 nodes to draw; no --svg written");
       return;
     }
     if (Status written = WriteFileAtomically(opt.svg, svg); !written) {
@@ -238,6 +258,14 @@ void RunDiff(const TableOptions& opt, GlobalOptions& options) {
   options.exit_code = TableDiffPasses(changes) || opt.exit_zero ? kExitOk : kExitInputError;
 }
 
+void AddToleranceOption(CLI::App& command, TableOptions& opt) {
+  AddNumberOption(command, "--tolerance", opt.tolerance_mm,
+                  "the placing tolerance (mm) the interpolation error between the nodes is a share of; above "
+                  "10 % the pitch to measure at next is advised",
+                  limits::kAccuracyMm)
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void AddTableCommand(CLI::App& app, GlobalOptions& options) {
@@ -247,7 +275,8 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   table->require_subcommand(1);
 
   CLI::App* build = table->add_subcommand(
-      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm) into an error table;\n"
+      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm[,kind]) into an error table\n"
+               "(kind check: check points off the nodes, averaged per position and kept in the table);\n"
                "warns about nodes whose scatter or set-to-set difference is far above the rest");
   build->add_option("RAW", opt.input, "the raw measurement CSV ('-' for stdin)")->required();
   build->add_option("-o,--output", opt.output, "the error table to write ('-' for stdout)")->required();
@@ -255,15 +284,20 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
 
   CLI::App* check = table->add_subcommand(
       "check", "Validate an error table: grid, values, no fold (det(I + grad Delta) >= 0.5), slopes,\n"
-               "and warn where the error changes sign between nodes or exceeds half the pitch");
+               "and warn where the error changes sign between nodes or exceeds half the pitch; print the\n"
+               "interpolation error between the nodes as a share of --tolerance (and the pitch to measure at\n"
+               "when it is more than 10 %)");
   check->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  AddToleranceOption(*check, opt);
   check->callback([&options] { RunCheck(opt, options); });
 
   CLI::App* stats = table->add_subcommand(
       "stats", "The paper's statistics per axis (max, min, mean, origin shift by the means, max |Delta - mean|,\n"
-               "stddev summary) and the inverse calibration's contraction factor and iteration bound");
+               "stddev summary), the inverse calibration's contraction factor and iteration bound, and the\n"
+               "interpolation error between the nodes as a share of --tolerance");
   stats->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
   stats->add_flag("--json", opt.json, "print JSON instead of text");
+  AddToleranceOption(*stats, opt);
   stats->callback([&options] { RunStats(opt, options); });
 
   for (bool inverse : {false, true}) {
@@ -274,8 +308,9 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                 : "Direct calibration: the actual positions F(n) = n + Delta(n) the robot reaches when\n"
                   "commanded to n; prints x_mm,y_mm,residual_mm,iterations (residual and iterations 0)");
     solve->add_option("TABLE", opt.input, "the error table CSV")->required();
-    solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
-        ->capture_default_str();
+    CLI::Option* points =
+        solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
+            ->capture_default_str();
     solve->add_option("-o,--output", opt.output, "where to write the results ('-' for stdout)")
         ->capture_default_str();
     solve->add_option("--outside", opt.outside,
@@ -289,12 +324,14 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                         "or paper (the paper's iterative interval search)")
           ->check(CLI::IsMember({"default", "paper"}))
           ->capture_default_str();
-      solve->add_option("--paper-tolerance", opt.paper_tolerance_mm,
-                        "the paper solver's stopping tolerance in mm")
-          ->check(CLI::PositiveNumber)
+      AddNumberOption(*solve, "--paper-tolerance", opt.paper_tolerance_mm, "the paper solver's stopping tolerance",
+                      limits::kPaperToleranceMm)
           ->capture_default_str();
     }
-    solve->callback([&options, inverse] { RunSolve(opt, options, inverse); });
+    solve->callback([&options, inverse, points] {
+      opt.points_given = points->count() > 0;
+      RunSolve(opt, options, inverse);
+    });
   }
 
   CLI::App* plot = table->add_subcommand(
@@ -312,8 +349,8 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   diff->add_option("A", opt.input, "the table in use now (CSV; '-' for stdin)")->required();
   diff->add_option("B", opt.new_input, "the re-measured table (CSV; '-' for stdin)")->required();
   diff->add_option("--cell", opt.cell, "a cell file: the changes within each of its regions' bounds too");
-  diff->add_option("--threshold", opt.threshold_um, "the gate: a node whose error changed by more than this many µm fails it")
-      ->check(CLI::NonNegativeNumber)
+  AddNumberOption(*diff, "--threshold", opt.threshold_um,
+                  "the gate: a node whose error changed by more than this many µm fails it", limits::kDiffThresholdUm)
       ->capture_default_str();
   diff->add_flag("--json", opt.json, "print JSON (schema smtcal-table-diff/1) instead of text");
   diff->add_option("--svg", opt.svg, "also draw the change as an SVG file: colour maps of both axes in µm and arrows");

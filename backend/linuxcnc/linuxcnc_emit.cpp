@@ -817,7 +817,17 @@ class Emitter {
   void EmitJump(const ir::Stmt& stmt, const Position& target, const ir::Expr* limz) {
     GExpr z = limz != nullptr ? Expr(*limz) : Num(cell_.robot.safe_limz_mm);
     Line(fmt::format("G0 Z{}", z), stmt.loc);
-    Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach (docs/measure.md, "Backlash"): every target is
+      // reached by the same last move as every node of the measurement.
+      Position from = target;
+      from.xyzu[0] = fmt::format("[{} - {}]", target.xyzu[0], Num(approach->x()));
+      from.xyzu[1] = fmt::format("[{} - {}]", target.xyzu[1], Num(approach->y()));
+      Line(fmt::format("G0 {}", Axes(from, false)), stmt.loc);
+      Line(fmt::format("G0 X{} Y{}", target.xyzu[0], target.xyzu[1]), stmt.loc);
+    } else {
+      Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    }
     Line(fmt::format("G0 Z{}", target.xyzu[2]), stmt.loc);
   }
 
@@ -917,7 +927,14 @@ class Emitter {
     --indent_;
     block("o<pick_place_correct> endif");
     block("G0 Z#6");
-    block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach: the last x-y move is robot.final_approach_mm, as
+      // at every node the tables were measured at (backlash taken up alike).
+      block(fmt::format("G0 X[#2 - {}] Y[#3 - {}] {}#5", Num(approach->x()), Num(approach->y()), axis));
+      block("G0 X#2 Y#3");
+    } else {
+      block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    }
     block("G0 Z#4");
     block("o<pick_place_vacuum> if [#8 EQ 1]");
     ++indent_;
@@ -1079,6 +1096,17 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                d.target_.string(), why)};
     }
   }
+  // The temporaries of killed runs go first, as a file output's do: a
+  // folder "OUTDIR.tmp.PID" of a process that no longer runs, holding the
+  // subroutines/ folder Open() makes first.
+  const std::string prefix = d.target_.filename().string() + ".tmp.";
+  const fs::path parent = d.target_.has_parent_path() ? d.target_.parent_path() : fs::path(".");
+  RemoveStaleTemporaries(parent.string(), prefix, [](const std::string& stale) {
+    std::error_code ignored;
+    if (fs::is_directory(fs::symlink_status(stale, ignored)) && fs::is_directory(fs::path(stale) / "subroutines", ignored)) {
+      fs::remove_all(stale, ignored);
+    }
+  });
   d.temp_ = d.target_;
   d.temp_ += fmt::format(".tmp.{}", ::getpid());
   fs::remove_all(d.temp_, error);
@@ -1099,6 +1127,10 @@ LinuxCncDirectory::~LinuxCncDirectory() {
 Status LinuxCncDirectory::Commit(const LinuxCncOutput& output) {
   std::error_code error;
   Status written = main_->Commit();
+  for (const EmbeddedFile& file : output.more_mains) {
+    if (!written) break;
+    written = WriteText(temp_ / file.name, file.text);
+  }
   for (const EmbeddedFile& file : output.subroutines) {
     if (!written) break;
     written = WriteText(temp_ / "subroutines" / file.name, file.text);

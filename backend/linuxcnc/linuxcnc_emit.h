@@ -32,6 +32,7 @@ struct LinuxCncOutput {
   std::string main_name;                  // "<program file stem>.ngc"
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
   std::vector<EmbeddedFile> dry_run;      // OUTDIR/dry-run/ (--dry-run-probe, linuxcnc_dry_run.h), or none
+  std::vector<EmbeddedFile> more_mains;   // further programs beside the main one (the measuring programs), or none
 };
 
 // Lowers the program, writing the main program's text to `main` as it is
@@ -56,7 +57,8 @@ std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view ma
 // The output directory OUTDIR: OUTDIR/<main_name> and OUTDIR/subroutines/*,
 // written into a temporary sibling (OUTDIR.tmp.PID) and swapped in by a
 // rename at Commit(), so OUTDIR is never half-written; a directory never
-// committed leaves nothing behind. An existing OUTDIR is replaced only when
+// committed leaves nothing behind, and one left by a killed smtcal is removed
+// the next time smtcal writes OUTDIR (as a file output's temporary is). An existing OUTDIR is replaced only when
 // it is an earlier smtcal output (its .ngc files open with smtcal's header
 // line, subroutines/ holds only smtcal_*.ngc); anything else is refused by
 // Open() with an Error naming what is in the way.

@@ -105,8 +105,9 @@ nlohmann::json ProcessJson(const ModeResult& m, const SimResult& result) {
 std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
   std::string field = fmt::format("tables {}", TablesName(truth.tables));
   if (truth.tables == TruthTables::kDerived) {
-    field += truth.noise ? fmt::format(" (nodes moved by {} x their standard error)", truth.perturbation_scale)
-                         : " (noise off: the tables as they are)";
+    field += truth.noise ? fmt::format(" (nodes moved by {} x their standard error", truth.perturbation_scale)
+                         : " (noise off: the nodes as they are";
+    field += fmt::format(", between them departing by {} x the interpolation estimate)", truth.interpolation_scale);
   }
   if (!truth.region_tables.empty()) field += fmt::format(", {} true table(s) given", truth.region_tables.size());
   switch (truth.outside) {

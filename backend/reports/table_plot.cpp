@@ -69,10 +69,7 @@ double NiceFloor(double v) {
   return base;
 }
 
-std::string Num(double v) {
-  std::string text = fmt::format("{:.2f}", v);
-  return text == "-0.00" ? "0.00" : text;
-}
+std::string Num(double v) { return SvgNum(v); }
 
 // A tick label: up to 3 decimals, trailing zeros dropped.
 std::string Tick(double v) {

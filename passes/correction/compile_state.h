@@ -152,6 +152,11 @@ struct CompileState {
   std::map<const ir::Stmt*, std::vector<TraceEvent>> cycle_traces;
   std::vector<CycleEstimate> cycles;
   bool trace_complete = true;  // false: the run hit its step limit (reported)
+  // false: verify sets every target's budget but reports no BudgetOverTolerance
+  // or FixtureBudgetUnbounded (simulate measures what the budget predicts and
+  // counts the findings from the targets; reported, they could fill the
+  // error limit and stop it)
+  bool report_budget_findings = true;
 
   int FindFixture(std::string_view name) const;  // index or -1, case-insensitive
   // The one copy of `text` this compile keeps.

@@ -63,7 +63,7 @@ class Regions final : public Pass {
       target.required = RequiredPosition(target, state);
       target.region = cell.RegionAt(Xy(target.required));
       if (target.region != nullptr) continue;
-      std::string x = FormatMm(target.required[0]), y = FormatMm(target.required[1]);
+      std::string x = FormatComputedMm(target.required[0]), y = FormatComputedMm(target.required[1]);
       if (std::holds_alternative<ir::PickPlace>(target.stmt->node)) {
         diags.Report(DiagKind::TargetOutsideRegions, where, keyword, target.text, x, y, RegionList(cell));
       } else {

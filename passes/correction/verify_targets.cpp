@@ -18,6 +18,7 @@
 
 #include <fmt/format.h>
 
+#include "calibration/motion_time.h"
 #include "ir/constant_fold.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
@@ -26,14 +27,6 @@
 namespace smtcal {
 
 namespace {
-
-// Time to move `distance` with a trapezoidal profile (triangular when short).
-double MoveTime(double distance, double speed, double accel) {
-  distance = std::abs(distance);
-  if (distance == 0 || speed <= 0 || accel <= 0) return 0;
-  if (distance < speed * speed / accel) return 2 * std::sqrt(distance / accel);
-  return distance / speed + speed / accel;
-}
 
 class VerifyTargets final : public Pass {
  public:
@@ -107,7 +100,7 @@ class VerifyTargets final : public Pass {
     if (worst == nullptr) return;
     std::string turn_text = worst_turn == 0 ? std::string() : fmt::format(" and turns {:+}°", worst_turn);
     diags.Report(DiagKind::FixtureShiftLeavesRegion, Where(target), TargetKeyword(*target.stmt), target.text,
-                 FormatMm(target.required[0]), FormatMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
+                 FormatComputedMm(target.required[0]), FormatComputedMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
                  FormatMm(region.x_mm.hi), FormatMm(region.y_mm.lo), FormatMm(region.y_mm.hi), binding.name,
                  fmt::format("{:.3f}", std::max(0.0, worst_shift)), worst->direction, turn_text,
                  FormatMm(fixture.max_shift_mm), FormatMm(fixture.max_rotation_deg));
@@ -142,10 +135,57 @@ class VerifyTargets final : public Pass {
     return text;
   }
 
+  // Which tables to measure at what pitch when the interpolation between
+  // their nodes takes too much of a budget: the target's own region and the
+  // regions under its fixture's trips. The part scales with the pitch
+  // squared; everything else stays.
+  static std::string InterpolationHint(const ErrorBudget& budget, const Target& target, const CompileState& state) {
+    const double part = budget[ErrorSource::kInterpolation].bound_mm;
+    const double own = target.region->interpolation.NormMm();
+    const double allowed = target.region->tolerance_mm - (target.budget_mm - part);
+    std::vector<const cell::Region*> regions = {target.region};
+    if (target.fixture >= 0) {
+      const FixtureErrorModel& model = state.ErrorModelFor(*state.fixtures[target.fixture].cell_fixture);
+      for (int r : model.trip_regions()) {
+        const cell::Region* region = r >= 0 ? &state.cell->regions[static_cast<std::size_t>(r)] : nullptr;
+        if (region != nullptr && std::find(regions.begin(), regions.end(), region) == regions.end()) {
+          regions.push_back(region);
+        }
+      }
+    }
+    std::string names;
+    double pitch = 0;
+    bool declared = false;
+    for (const cell::Region* region : regions) {
+      names += fmt::format("{}'{}'", names.empty() ? "" : ", ", region->name);
+      pitch = std::max(pitch, region->interpolation.PitchMm());
+      declared = declared || region->interpolation.Kind() == InterpolationKind::kDeclared;
+    }
+    const double new_pitch = PitchForShare(pitch, part, allowed);
+    const std::string through_trips =
+        target.fixture >= 0 ? fmt::format(" and {:.4f} mm more through the trips", part - own) : std::string();
+    std::string text = fmt::format(
+        "between the nodes of the table{} of region{} {} (largest pitch {} mm) the robot's error may depart from the "
+        "interpolation by {:.4f} mm here{}, {}; ",
+        regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", names, fmt::format("{:.1f}", pitch), own,
+        through_trips, InterpolationKindDescription(target.region->interpolation.Kind()));
+    text += new_pitch > 0 ? fmt::format("measure {} at a pitch of at most {:.1f} mm", regions.size() == 1 ? "it" : "them",
+                                        new_pitch)
+                          : std::string("no pitch fits while the other parts take the whole tolerance");
+    if (declared) {
+      text += fmt::format(", or measure check points at {} cell centres (docs/error-tables.md)",
+                          regions.size() == 1 ? "its" : "their");
+    }
+    return text;
+  }
+
   // What to do about the largest part of a budget.
-  static std::string BudgetHint(ErrorSource largest, const Target& target, const CompileState& state) {
+  static std::string BudgetHint(ErrorSource largest, const ErrorBudget& budget, const Target& target,
+                                const CompileState& state) {
     const cell::Fixture* fixture = target.fixture >= 0 ? state.fixtures[target.fixture].cell_fixture : nullptr;
     switch (largest) {
+      case ErrorSource::kInterpolation:
+        return InterpolationHint(budget, target, state);
       case ErrorSource::kUncalibratedTrips:
         return fmt::format("trips of fixture '{}' lie outside every calibrated table, so the robot's own error there "
                            "moves the whole board: calibrate a region under its markers (docs/cell.md)",
@@ -180,7 +220,7 @@ class VerifyTargets final : public Pass {
     target.budget_bounded = budget.bounded;
     target.budget_mm = total.BudgetMm();
     target.worst_case_mm = total.worst_mm;
-    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) return;
+    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node) || !state.report_budget_findings) return;
     if (!budget.bounded) {
       if (!unbounded_reported.insert(target.fixture).second) return;
       const FixtureBinding& binding = state.fixtures[target.fixture];
@@ -198,7 +238,7 @@ class VerifyTargets final : public Pass {
                                     FormatMm(target.region->tolerance_mm), target.region->name,
                                     ErrorSourceDescription(largest),
                                     fmt::format("{:.4f}", budget[largest].BudgetMm()),
-                                    BudgetHint(largest, target, state));
+                                    BudgetHint(largest, budget, target, state));
     Diagnostics::AddNote(diag, Where(target), fmt::format("the budget's parts, each alone at 4 sigma (mm): {}",
                                                           BudgetParts(budget)));
   }

@@ -24,6 +24,9 @@
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
 #   messages every operator message (an abort is one).
+# With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
+# every Place also records where the robot really was ("real": the model's
+# position latched in the servo thread when the valve went off).
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
 import os
@@ -66,6 +69,7 @@ def place_board(pose, sensor_models):
 
 def main():
     plan = json.load(open(os.environ["SMTCAL_SIM_PLAN"]))
+    real_pins = os.environ.get("SMTCAL_SIM_REAL_PINS", "")  # the robot model's component, when there is one
     out_path = os.environ["SMTCAL_SIM_RUN"]
     started = time.monotonic()
     record = {"cycles": [], "messages": [], "vacuum": [], "end": None, "times": {}}
@@ -89,6 +93,15 @@ def main():
         os.replace(out_path + ".tmp", out_path)
 
     stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+    reader = None
+    if real_pins:
+        import hal as hal_module
+        reader = hal_module.component("smtcal-sim-reader")
+        reader.newpin("x", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.newpin("y", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.ready()
+        hal([f"net placed-x {real_pins}.x-latched => smtcal-sim-reader.x",
+             f"net placed-y {real_pins}.y-latched => smtcal-sim-reader.y"])
 
     def wait_for(predicate, what, timeout_s=30):
         end = time.monotonic() + timeout_s
@@ -148,6 +161,10 @@ def main():
             if out == VACUUM_OUT:
                 event = {"t": now(), "on": bool(stat.dout[out]), "position": list(stat.position[:6]),
                          "velocity": stat.current_vel, "cycle": len(record["cycles"]) - 1}
+                if reader is not None and not event["on"]:
+                    # Where the modelled robot really was when the valve went
+                    # off (latched in the servo thread by run_measure.py's model).
+                    event["real"] = [reader["x"], reader["y"]]
                 record["vacuum"].append(event)
             elif stat.dout[out] and clamped:
                 # The program released the board: this cycle is done.

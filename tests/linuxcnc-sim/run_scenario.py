@@ -135,8 +135,11 @@ def check_prerequisites():
 
 # ------------------------------------------------------------------ the machine
 
-def derive_ini(work, program_dir, dry_run):
-    """paper-cell.ini made headless, with the sensor HAL and the program's subroutines."""
+def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("marker-sensor.hal",)):
+    """paper-cell.ini made headless, with the sensor HAL and the program's subroutines.
+    `display`: the DISPLAY program (a file of this folder); `extra_hals`: HAL
+    files loaded after the example's, in order (files of this folder, or
+    paths of files the scenario wrote into `work`)."""
     lines = open(os.path.join(EXAMPLE, "paper-cell.ini")).read().splitlines()
     out, section = [], ""
     for line in lines:
@@ -145,7 +148,7 @@ def derive_ini(work, program_dir, dry_run):
             section = stripped
         key = stripped.split("=", 1)[0].strip() if "=" in stripped and not stripped.startswith("#") else ""
         if section == "[DISPLAY]" and key == "DISPLAY":
-            line = "DISPLAY = " + os.path.join(work, "driver.py")
+            line = "DISPLAY = " + os.path.join(work, display)
         elif section == "[DISPLAY]" and key in ("INTRO_GRAPHIC", "INTRO_TIME"):
             continue  # popimage needs X
         elif section == "[RS274NGC]" and key == "SUBROUTINE_PATH":
@@ -154,18 +157,20 @@ def derive_ini(work, program_dir, dry_run):
                 line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
-            out.append("HALFILE = " + os.path.join(work, "marker-sensor.hal"))
+            for hal in extra_hals:
+                out.append("HALFILE = " + os.path.join(work, os.path.basename(hal)))
     ini = os.path.join(work, "sim.ini")
     # LinuxCNC reads nothing outside the scenario's folder (see work_root).
-    for name in ("driver.py", "marker-sensor.hal"):
-        shutil.copy(os.path.join(HERE, name), work)
+    for name in (display,) + tuple(extra_hals):
+        if not os.path.isabs(name) and os.path.exists(os.path.join(HERE, name)):
+            shutil.copy(os.path.join(HERE, name), work)
     open(ini, "w").write("\n".join(out) + "\n")
     for name in ("paper-cell.hal", "paper-cell.tbl", "paper-cell.var"):
         shutil.copy(os.path.join(EXAMPLE, name), work)
     return ini
 
 
-def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
+def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None, modules=None):
     tmp = os.path.join(work, "tmp")
     os.makedirs(tmp, exist_ok=True)
     os.chmod(tmp, 0o1777)  # rtapi_app binds its socket as RTAPI_UID
@@ -173,11 +178,16 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
     os.makedirs(home, exist_ok=True)
     env = dict(os.environ, RTAPI_UID="65534", RTAPI_FIFO_PATH="/tmp/rtapi_fifo", HOME=home,
                SMTCAL_SIM_PLAN=plan_path, SMTCAL_SIM_RUN=run_path)
+    env.update(extra_env or {})
     env.pop("DISPLAY", None)  # no X
     # Inside: a private /tmp (LinuxCNC's lock file and temporaries), then LinuxCNC.
+    # `modules`: a folder of realtime modules seen as LinuxCNC's own
+    # (rtapi_app loads only from /usr/lib/linuxcnc/modules), in this run only.
     inner = 'mount --bind "$0" /tmp && cd "$1" && exec linuxcnc -r "$2"'
+    if modules:
+        inner = 'mount --bind "$3" /usr/lib/linuxcnc/modules && ' + inner
     argv = ["timeout", "-k", "10", str(timeout_s + 60), "unshare", "--pid", "--fork", "--kill-child",
-            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini]
+            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini, modules or ""]
     with open(os.path.join(work, "linuxcnc.log"), "w") as log_file:
         return subprocess.run(argv, env=env, stdout=log_file, stderr=subprocess.STDOUT).returncode
 
@@ -218,6 +228,25 @@ print(out)
 f.write("shutdown\\r\\n")
 f.flush()
 """
+
+
+def run_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs):
+    """Runs LinuxCNC with its driver (start_linuxcnc; kwargs go there) and
+    returns the driver's record and the seconds LinuxCNC ran. Fails when a
+    process of the run outlives it or the driver left no record; skips
+    where LinuxCNC could not start."""
+    began = time.monotonic()
+    code = start_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs)
+    machine_s = time.monotonic() - began
+    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
+    if left:
+        fail("processes of the run outlived it: " + "; ".join(left))
+    if not os.path.exists(run_path):
+        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
+        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
+            skip("LinuxCNC could not start here:\n" + tail)
+        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
+    return json.load(open(run_path)), machine_s
 
 
 def work_root(path):
@@ -376,18 +405,7 @@ def main():
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
-    machine_started = time.monotonic()
-    code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
-    machine_s = time.monotonic() - machine_started
-    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
-    if left:
-        fail("processes of the run outlived it: " + "; ".join(left))
-    if not os.path.exists(run_path):
-        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
-        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
-            skip("LinuxCNC could not start here:\n" + tail)
-        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
-    record = json.load(open(run_path))
+    record, machine_s = run_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
     log(f"scenario {args.scenario}: {os.path.basename(scenario['program'])}, {len(record['cycles'])} cycle(s), "
         f"LinuxCNC ran {machine_s:.1f} s (ready after {record['times'].get('ready_s', 0):.1f} s), "
         f"run ended: {record['end']}")

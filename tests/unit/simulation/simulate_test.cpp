@@ -19,7 +19,9 @@
 #include <nlohmann/json.hpp>
 
 #include "simulation/sim_random.h"
+#include "simulation/true_field.h"
 #include "simulation/virtual_cell.h"
+#include "tests/unit/calibration/fixture_test_cell.h"
 #include "tests/unit/test_support.h"
 
 namespace smtcal {
@@ -84,6 +86,54 @@ TEST(SimRandom, TransformsAreOurOwnAndStable) {
   }
   EXPECT_NEAR(sum / kDraws, 0.0, 0.05);
   EXPECT_NEAR(squares / kDraws, 1.0, 0.05);
+}
+
+// The default truth departs from the tables between their nodes by the
+// region's interpolation estimate: zero at every node, at most the estimate
+// anywhere, and the estimate itself at some cell centres (never kinder).
+TEST(TrueField, DepartsBetweenTheNodesByTheInterpolationEstimate) {
+  std::mt19937_64 rng(Seed());
+  cell::Cell cell;
+  cell.robot.limits = {cell::Interval{0, 400}, cell::Interval{0, 300}, cell::Interval{-30, 0},
+                       cell::Interval{-360, 360}};
+  cell.robot.repeatability_mm = 0.005;
+  cell.robot.uncalibrated_accuracy_mm = 0.25;
+  cell.regions.push_back(test::RegionOf("layer", test::RandomSmoothTable(rng, 150, 60, 50, 50, 3, 0.15)));
+  cell::Region& region = cell.regions.front();
+  region.interpolation = cell::RegionInterpolation(cell.robot, region.table);
+  ASSERT_EQ(region.interpolation.Kind(), InterpolationKind::kDeclared);
+  TruthSpec truth;
+  truth.noise = false;  // the nodes as they are: the departure alone
+  const CalibrationMap map(region.table);
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const TrueField field(cell, truth, seed);
+    auto departure = [&](const Eigen::Vector2d& n) { return field.Actual(n) - n - map.Delta(n); };
+    for (TableAxis axis : kTableAxes) {
+      const int a = static_cast<int>(axis);
+      const AxisTable& t = region.table[axis];
+      const double estimate = region.interpolation.axes[static_cast<std::size_t>(a)].estimate_mm;
+      double largest = 0;
+      for (std::size_t j = 0; j < t.ny(); ++j) {
+        for (std::size_t i = 0; i < t.nx(); ++i) {
+          const Eigen::Vector2d node(t.xs[i], t.ys[j]);
+          if (map.Inside(node)) {
+            EXPECT_NEAR(departure(node)[a], 0.0, 1e-12) << "node " << node.transpose();
+          }
+          if (i + 1 == t.nx() || j + 1 == t.ny()) continue;
+          const Eigen::Vector2d centre(0.5 * (t.xs[i] + t.xs[i + 1]), 0.5 * (t.ys[j] + t.ys[j + 1]));
+          largest = std::max(largest, std::abs(departure(centre)[a]));
+        }
+      }
+      for (int k = 0; k < 2000; ++k) {
+        const Eigen::Vector2d n(test::Uniform(rng, 150.004, 200), test::Uniform(rng, 60, 109.997));
+        EXPECT_LE(std::abs(departure(n)[a]), estimate * (1 + 1e-12));
+      }
+      EXPECT_NEAR(largest, estimate, 1e-9 * estimate) << "seed " << seed << " axis " << AxisName(axis);
+    }
+  }
+  truth.interpolation_scale = 0;
+  const TrueField none(cell, truth, 1);
+  EXPECT_EQ(none.Actual({175, 85}), Eigen::Vector2d(175, 85) + map.Delta({175, 85}));
 }
 
 TEST(Simulate, SameSeedSameReportByteForByte) {
