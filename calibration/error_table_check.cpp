@@ -147,8 +147,8 @@ void WarnOverHalfPitch(const ErrorTable& table, const std::vector<OverHalfPitchF
   }
 }
 
-void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
-  for (const TableOutlier& outlier : FindTableOutliers(table)) {
+void ReportOutliers(const ErrorTable& table, const std::vector<TableOutlier>& outliers, Diagnostics& diags) {
+  for (const TableOutlier& outlier : outliers) {
     const AxisTable& t = table[outlier.axis];
     diags.Report(DiagKind::TableOutlierNode, t.Origin(outlier.i, outlier.j), AxisName(outlier.axis),
                  Signed(outlier.value_mm), FormatMm(t.xs[outlier.i]), FormatMm(t.ys[outlier.j]),
@@ -159,10 +159,16 @@ void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
 
 }  // namespace
 
-TableWarningFindings FindTableWarnings(const ErrorTable& table) {
+TableWarningFindings FindTableWarnings(const ErrorTable& table, const std::vector<TableOutlier>& outliers) {
   TableWarningFindings findings;
   for (TableAxis axis : kTableAxes) {
     const AxisTable& t = table[axis];
+    // A node reported as an outlier is left out: its slip is reported once,
+    // as what it is, and never again as a sign change or a large error.
+    std::vector<bool> skip(t.error_mm.size(), false);
+    for (const TableOutlier& o : outliers) {
+      if (o.axis == axis) skip[t.Index(o.i, o.j)] = true;
+    }
     // A node's value is "clearly of its sign" when it is farther from zero
     // than kSignChangeMinMm and three of its standard errors: smaller values
     // are noise around zero, where the paper's condition says nothing.
@@ -172,6 +178,7 @@ TableWarningFindings FindTableWarnings(const ErrorTable& table) {
     };
     SignChangeFinding sign{axis};
     auto visit = [&](std::size_t i, std::size_t j, std::size_t i2, std::size_t j2) {
+      if (skip[t.Index(i, j)] || skip[t.Index(i2, j2)]) return;
       if (!(t.At(i, j) * t.At(i2, j2) < 0) || !clear(i, j) || !clear(i2, j2)) return;
       if (sign.pairs++ == 0) sign.i = i, sign.j = j, sign.i2 = i2, sign.j2 = j2;
     };
@@ -187,6 +194,7 @@ TableWarningFindings FindTableWarnings(const ErrorTable& table) {
     double worst_ratio = 0;
     for (std::size_t j = 0; j < t.ny(); ++j) {
       for (std::size_t i = 0; i < t.nx(); ++i) {
+        if (skip[t.Index(i, j)]) continue;
         double pitch = std::numeric_limits<double>::infinity();
         if (i > 0) pitch = std::min(pitch, t.xs[i] - t.xs[i - 1]);
         if (i + 1 < t.nx()) pitch = std::min(pitch, t.xs[i + 1] - t.xs[i]);
@@ -276,14 +284,21 @@ TableAnalysis AnalyzeTable(const ErrorTable& table) {
 
 bool ValidateErrorTable(const ErrorTable& table, Diagnostics& diags, TableWarnings warnings,
                         TableAnalysis* analysis_out) {
-  TableAnalysis analysis = AnalyzeTable(table);
   std::size_t errors_before = diags.error_count();
-  ReportOutliers(table, diags);
-  ReportFolds(table, analysis, diags);
+  const std::vector<TableOutlier> outliers = FindTableOutliers(table);
+  ReportOutliers(table, outliers, diags);
+  // The fold and slope checks look at the table with its outliers repaired:
+  // a slipped node folds the map around it, and that is the slip, reported
+  // once above. A fold that remains is a problem of its own.
+  const ErrorTable repaired = outliers.empty() ? ErrorTable() : WithOutliersRepaired(table, outliers);
+  const ErrorTable& checked = outliers.empty() ? table : repaired;
+  TableAnalysis analysis = AnalyzeTable(checked);
+  const std::size_t before_folds = diags.error_count();
+  ReportFolds(checked, analysis, diags);
   // A folding table is also steep; its fold is the message that matters.
-  if (diags.error_count() == errors_before) ReportSteep(table, analysis, diags);
+  if (diags.error_count() == before_folds) ReportSteep(checked, analysis, diags);
   if (warnings == TableWarnings::kReport) {
-    const TableWarningFindings findings = FindTableWarnings(table);
+    const TableWarningFindings findings = FindTableWarnings(table, outliers);
     WarnSignChanges(table, findings.sign_changes, diags);
     WarnOverHalfPitch(table, findings.over_half_pitch, diags);
   }

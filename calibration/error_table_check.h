@@ -25,6 +25,7 @@
 
 #include "base/diagnostics.h"
 #include "calibration/error_table.h"
+#include "calibration/table_outliers.h"
 
 namespace smtcal {
 
@@ -72,7 +73,8 @@ struct TableWarningFindings {
   std::vector<SignChangeFinding> sign_changes;      // one per axis that has any
   std::vector<OverHalfPitchFinding> over_half_pitch;  // likewise
 };
-TableWarningFindings FindTableWarnings(const ErrorTable& table);
+// Nodes in `outliers` (FindTableOutliers) are left out of both.
+TableWarningFindings FindTableWarnings(const ErrorTable& table, const std::vector<TableOutlier>& outliers = {});
 // The same in one line per finding, for the summary the deciding commands
 // (verify, compile, cell check) print once per table: "Δx changes sign
 // between 5 pairs of neighbouring nodes (first at (150.000, 60.000))".

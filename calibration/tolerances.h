@@ -4,6 +4,8 @@
 // is. Limits of the language and the controller live in limits.h instead.
 #pragma once
 
+#include <cstddef>
+
 namespace smtcal {
 
 // --- error tables and inverse calibration ------------------------------------
@@ -68,6 +70,17 @@ inline constexpr double kNoisyNodeFloorMm = 0.001;
 // kSetShiftFloorMm: the robot or the fixture moved between the sets.
 inline constexpr double kSetShiftFactor = 6.0;
 inline constexpr double kSetShiftFloorMm = 0.001;
+// Screening the readings before they are averaged (calibration/reading_screen.h):
+// a reading farther from its set's median than this many robust scatters
+// (and kOutlierFloorMm) is an outlier; a set needs this many readings to
+// have a centre of its own. With the paper's 2.5 µm repetition scatter the
+// limit is 25 µm: ten times the largest deviation 2420 normal readings give.
+inline constexpr double kReadingOutlierFactor = 10.0;
+inline constexpr std::size_t kScreenMinSetSize = 3;
+// Of two sets a decimal point apart, the one farther from what the
+// neighbouring nodes predict is the culprit when the other is at least this
+// many times nearer; otherwise the node cannot tell.
+inline constexpr double kSetSlipDecisiveRatio = 3.0;
 
 // --- the cell file -------------------------------------------------------------
 // (frontend/cell_toml.cpp; docs/cell.md)
@@ -163,5 +176,9 @@ inline constexpr double kSignChangeMinMm = 0.005;
 inline constexpr double kOutlierScatterFactor = 10;
 inline constexpr double kOutlierNoiseFactor = 6;
 inline constexpr double kOutlierFloorMm = 0.005;
+// A node's standard error excuses its disagreement only up to this many times
+// its axis's median standard error: a node whose own measurements scatter
+// farther than that holds a bad measurement, and is the one to blame.
+inline constexpr double kOutlierNoiseCapFactor = 10;
 
 }  // namespace smtcal

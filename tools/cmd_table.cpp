@@ -32,6 +32,7 @@ struct TableOptions {
   std::string solver = "default";
   double paper_tolerance_mm = kPaperSolverTolMm;
   double tolerance_mm = kDefaultTableToleranceMm;  // check, stats: what the interpolation error is a share of
+  bool drop_outlier_readings = false;
   // table diff
   std::string new_input;
   std::string cell;
@@ -112,7 +113,9 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
   Diagnostics diags(sources);
   std::optional<std::vector<RawMeasurement>> raw = ReadRawMeasurements(file.value(), diags);
   std::optional<ErrorTable> table;
-  if (raw) table = BuildErrorTable(BaseName(opt.input), *raw, SourceLoc{file.value(), 0, 0}, diags);
+  BuildOptions build;
+  build.drop_outlier_readings = opt.drop_outlier_readings;
+  if (raw) table = BuildErrorTable(BaseName(opt.input), *raw, SourceLoc{file.value(), 0, 0}, diags, build);
   if (table) ValidateErrorTable(*table, diags, TableWarnings::kReport);
   std::string text;
   if (table && !diags.has_errors()) {
@@ -277,9 +280,13 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   CLI::App* build = table->add_subcommand(
       "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm[,kind]) into an error table\n"
                "(kind check: check points off the nodes, averaged per position and kept in the table);\n"
-               "warns about nodes whose scatter or set-to-set difference is far above the rest");
+               "a reading or a whole set far from the other readings at its position is an error naming\n"
+               "its line and the likely slip; warns about nodes whose scatter or set-to-set difference is far above the rest");
   build->add_option("RAW", opt.input, "the raw measurement CSV ('-' for stdin)")->required();
   build->add_option("-o,--output", opt.output, "the error table to write ('-' for stdout)")->required();
+  build->add_flag("--drop-outlier-readings", opt.drop_outlier_readings,
+                  "leave readings (and sets) far from their node's others out of the means,\n"
+                  "each reported as a warning, instead of stopping at them");
   build->callback([&options] { RunBuild(opt, options); });
 
   CLI::App* check = table->add_subcommand(

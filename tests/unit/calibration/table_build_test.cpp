@@ -1,6 +1,6 @@
-// Building tables from raw measurements: the per-node statistics, and the
+// Building tables from raw measurements: the per-node statistics, the
 // warnings for noisy nodes and shifted sets (with no false alarms on clean
-// data). Random data print their seed on failure.
+// data), and a slipped reading or set reported once, at itself. Random data print their seed on failure.
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "calibration/error_table_build.h"
+#include "calibration/error_table_check.h"
 
 namespace smtcal {
 namespace {
@@ -110,6 +111,80 @@ TEST(TableBuild, ANoisyNodeAndAShiftedSetAreReported) {
     EXPECT_NE(diags.all()[1].message.find("node (30.000, 5.000) of the y table"), std::string::npos)
         << diags.all()[1].message;
   }
+}
+
+// One reading slipped (x10, x1000 or a lost sign): exactly one error, at that
+// reading, naming the slip; the table averaged without it passes its own
+// checks, so nothing else is reported. Left out with the option: one
+// warning, and the node's mean of the other 19.
+TEST(TableBuild, ASlippedReadingIsOneErrorAndNothingElse) {
+  struct Slip {
+    double factor;
+    const char* named;
+  };
+  // A lost sign is not tried here: this table's errors are too small (under
+  // 18 µm) for a lost sign to move a reading well past the screen's 25 µm;
+  // the golden fail_raw_check_reading_outlier and reading_screen_test cover it.
+  for (const Slip slip : {Slip{10, "a decimal point moved"}, Slip{1000, "micrometres written as millimetres"}}) {
+    for (int k = 0; k < 10; ++k) {
+      const std::uint64_t seed = BaseSeed() + 200 + static_cast<std::uint64_t>(k);
+      SCOPED_TRACE(fmt::format("seed {}, factor {}", seed, slip.factor));
+      std::mt19937_64 rng(seed);
+      std::vector<RawMeasurement> raw = Measure(rng, -1, -1);
+      // A reading the slip moves well beyond the screen's 25 µm, at a node
+      // clearly off zero: near zero a value x10 and one x1000 both return
+      // to about zero, and no message can tell which slip it was.
+      std::size_t slipped = rng() % raw.size();
+      for (std::size_t tries = 0;
+           std::abs(raw[slipped].error_mm) < 0.01 || std::abs(raw[slipped].error_mm * (slip.factor - 1)) < 0.035;
+           ++tries) {
+        ASSERT_LT(tries, raw.size()) << "no reading fits";
+        slipped = (slipped + 1) % raw.size();
+      }
+      raw[slipped].error_mm *= slip.factor;
+      for (bool drop : {false, true}) {
+        SourceManager sources;
+        Diagnostics diags(sources);
+        BuildOptions options;
+        options.drop_outlier_readings = drop;
+        std::optional<ErrorTable> table = BuildErrorTable("t", raw, SourceLoc{}, diags, options);
+        ASSERT_TRUE(table.has_value()) << diags.RenderText();
+        // The test data change sign between nodes (warnings of their own): the
+        // table's errors are what must stay silent.
+        EXPECT_TRUE(ValidateErrorTable(*table, diags, TableWarnings::kSkip)) << diags.RenderText();
+        ASSERT_EQ(diags.all().size(), 1u) << diags.RenderText();
+        const Diagnostic& d = diags.all()[0];
+        EXPECT_EQ(d.kind, drop ? DiagKind::RawReadingLeftOut : DiagKind::RawReadingOutlier);
+        EXPECT_NE(d.message.find(fmt::format("set {}, repetition {}", raw[slipped].set, raw[slipped].repetition)),
+                  std::string::npos) << d.message;
+        EXPECT_NE(d.message.find(fmt::format("node ({:.3f}, {:.3f})", raw[slipped].x_mm, raw[slipped].y_mm)),
+                  std::string::npos) << d.message;
+        EXPECT_NE(d.message.find(slip.named), std::string::npos) << d.message;
+        const AxisTable& t = (*table)[raw[slipped].axis];
+        const std::size_t node = t.Index(static_cast<std::size_t>(std::lround(raw[slipped].x_mm / 5)),
+                                         static_cast<std::size_t>(std::lround(raw[slipped].y_mm / 5)));
+        EXPECT_EQ(t.count[node], 19);
+      }
+    }
+  }
+}
+
+// A whole set logged in micrometres: one error naming the set, nothing else.
+TEST(TableBuild, ASetInMicrometresIsOneError) {
+  std::mt19937_64 rng(BaseSeed() + 300);
+  std::vector<RawMeasurement> raw = Measure(rng, -1, -1);
+  for (RawMeasurement& m : raw) {
+    if (m.axis == TableAxis::Y && m.x_mm == 20 && m.y_mm == 35 && m.set == 2) m.error_mm *= 1000;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<ErrorTable> table = BuildErrorTable("t", raw, SourceLoc{}, diags);
+  ASSERT_TRUE(table.has_value()) << diags.RenderText();
+  EXPECT_TRUE(ValidateErrorTable(*table, diags, TableWarnings::kSkip)) << diags.RenderText();
+  ASSERT_EQ(diags.all().size(), 1u) << diags.RenderText();
+  EXPECT_EQ(diags.all()[0].kind, DiagKind::RawSetSlip);
+  EXPECT_NE(diags.all()[0].message.find("set 2 of node (20.000, 35.000) of the y table"), std::string::npos)
+      << diags.all()[0].message;
 }
 
 }  // namespace

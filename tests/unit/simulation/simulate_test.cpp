@@ -107,7 +107,8 @@ TEST(TrueField, DepartsBetweenTheNodesByTheInterpolationEstimate) {
   const CalibrationMap map(region.table);
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     const TrueField field(cell, truth, seed);
-    auto departure = [&](const Eigen::Vector2d& n) { return field.Actual(n) - n - map.Delta(n); };
+    // Evaluated here: an Eigen expression of temporaries must not outlive them.
+    auto departure = [&](const Eigen::Vector2d& n) -> Eigen::Vector2d { return field.Actual(n) - n - map.Delta(n); };
     for (TableAxis axis : kTableAxes) {
       const int a = static_cast<int>(axis);
       const AxisTable& t = region.table[axis];
