@@ -6,8 +6,12 @@
 // The model of one cycle with the board at pose P (its nominal pose moved by
 // a shift of its origin and a rotation about it):
 //   - the robot moves as the `truth` cell's tables say (the diff takes NEW's
-//     cell: the robot as last measured), so the marker scan latches the
-//     commands c with F_truth(c) = P . (each expected trip) (CommandedTrips);
+//     cell: the robot as last measured). The program's scan paths run where
+//     the fixture's nominal pose puts them; the marker scan latches the
+//     command c on each leg at which the robot's real position F_truth(c)
+//     crosses the line of the trip's marker edge of the board at P
+//     (ScannedTrips): a trip moves along its leg, and one whose leg ends
+//     first is not made;
 //   - the controller calibrates those trips through ITS cell's tables and
 //     estimates FIX with its fixture's estimator, every check included
 //     (ScanFixture); a scan that fails a check places nothing;
@@ -43,17 +47,33 @@ struct BoardPose {
   bool nominal() const { return shift_x_mm == 0 && shift_y_mm == 0 && rotation_deg == 0; }
 };
 
-// The poses the diff evaluates (docs/diff.md): the nominal pose first; then
-// the board turned by +-r alone; then shifted by s in each of the eight
-// directions 0, 45, ..., 315 degrees, each without rotation and turned by -r
-// and +r: 27 poses, with s = kDiffPoseLimitFraction * max_shift_mm and
-// r = kDiffPoseLimitFraction * max_rotation_deg. They sample the limits; the
-// largest move between them is not a bound.
+// The directions the diff evaluates the board in (docs/diff.md): the
+// nominal pose first; then the board turned by +-r alone; then shifted by s
+// in each of the eight directions 0, 45, ..., 315 degrees, each without
+// rotation and turned by -r and +r: 27 poses, with s = kDiffPoseLimitFraction
+// * max_shift_mm and r = kDiffPoseLimitFraction * max_rotation_deg. A scan
+// need not accept them all (its trips may leave the trip window or their
+// edges first): MachineModel::Poses brings each in to what the robot's scan
+// accepts. They sample the limits; the largest move between them is not a
+// bound.
 std::vector<BoardPose> CheckLimitPoses(const cell::Fixture& fixture);
+// `pose` scaled by `fraction` (shift and rotation alike).
+BoardPose ScaledPose(const BoardPose& pose, double fraction);
 // FIX of the board at `pose`.
 Eigen::Affine3d BoardPoseFix(const cell::Fixture& fixture, const BoardPose& pose);
 // "nominal pose", "shifted 1.980 mm toward 45°, turned +0.990°".
 std::string DescribeBoardPose(const BoardPose& pose);
+
+// Where the scan of `fixture` latches its trips, in trip order, with the
+// board at `board` on a robot whose real position for a command c is
+// robot.Forward(c): the program's scan paths run where the fixture's nominal
+// pose puts them, and trip k is the command on its leg at which the real
+// position crosses its marker edge of the board at `board` (the sensor is
+// perfect). The edge is taken as its whole line (a LinuxCNC output does not
+// record where a marker's edge ends); nullopt where the leg ends before the
+// real path meets it: the scan is refused.
+std::vector<std::optional<Eigen::Vector2d>> ScannedTrips(const cell::Fixture& fixture, const PointCorrector& robot,
+                                                         const Eigen::Affine3d& board);
 
 // One point on the machine.
 struct MachinePoint {
@@ -77,6 +97,11 @@ class MachineModel {
   // The poses of the side's fixture `fixture` (index in its cell): those of
   // the truth cell's fixture of the same name, which is where the board
   // really is, or the side's own when the truth has no such fixture.
+  // CheckLimitPoses, each brought in to kDiffPoseLimitFraction of the
+  // farthest pose in its direction (to 1/1024) that the robot's own scan
+  // accepts (the fixture's scan through the truth cell's tables): the poses
+  // a cycle can run with, within the limits. The same for both sides of a
+  // diff (they share the truth).
   const std::vector<BoardPose>& Poses(std::size_t fixture) const;
   // FIX as the side's controller estimates it at pose `pose`, or why its
   // scan refuses the board there.
@@ -96,6 +121,7 @@ class MachineModel {
     std::vector<std::string> refused;                 // per pose: why the scan failed
   };
   const Scans& ScansOf(std::size_t fixture) const;
+  BoardPose AcceptedPose(const cell::Fixture& board, const BoardPose& limit) const;
   MachinePoint Commanded(const CorrectedPoint& corrected) const;
 
   const cell::Cell& side_;

@@ -180,7 +180,11 @@ std::string MachineHeader(const ProgramDiff& diff) {
               ? std::string("the cells hold the same tables and fixtures\n")
               : fmt::format("the cells differ in: {}\n", fmt::join(diff.tables_differ, ", "));
   text += "on the machine: each program through its own cell, the robot moving as NEW's cell says";
-  if (diff.poses > 1) text += fmt::format("; board targets at {} poses within the fixtures' check limits", diff.poses);
+  if (diff.poses > 1) {
+    text += fmt::format(
+        "; board targets at {} poses within the fixtures' check limits, as far out as the robot's scan accepts",
+        diff.poses);
+  }
   if (!diff.refused_poses.empty()) {
     text += fmt::format(" ({} refused by both programs' scans: not compared)", fmt::join(diff.refused_poses, ", "));
   }
