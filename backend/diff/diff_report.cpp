@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -465,37 +466,43 @@ double Distance(double x, double y, const Box& b) {
 // first in eight directions, inside `area`, that covers no drawn mark, arrow
 // or earlier label. Right beside the tip it must also be nearer its own tip
 // than any other mark's point (`points`), so it cannot be read as another's;
-// further away a leader line says whose it is. Else the box that covers fewest.
+// further away a leader line says whose it is. Else the box that covers
+// fewest, another label last of all.
 Box PlaceLabel(double ax, double ay, double width, const Box& area, const std::vector<Box>& marks,
                const std::vector<Segment>& arrows, const std::vector<Box>& labels,
                const std::vector<std::pair<double, double>>& points) {
   const double height = kLabelFontPx + 3;
   Box best{};
   int best_hits = -1;
-  for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0}) {
-    for (int direction = 0; direction < 8; ++direction) {
-      // E, W, N, S, NE, SE, NW, SW
-      const int hx = direction == 0 || direction == 4 || direction == 5 ? 1
-                     : direction == 1 || direction == 6 || direction == 7 ? -1
-                                                                         : 0;
-      const int vy = direction == 2 || direction == 4 || direction == 6 ? -1
-                     : direction == 3 || direction == 5 || direction == 7 ? 1
-                                                                         : 0;
-      const double diagonal = hx != 0 && vy != 0 ? 0.7 : 1.0;
-      const double left = hx > 0 ? ax + d * diagonal : hx < 0 ? ax - d * diagonal - width : ax - width / 2;
-      const double top = vy > 0 ? ay + d * diagonal : vy < 0 ? ay - d * diagonal - height : ay - height / 2;
+  // Text over text is the worst a label can do, a leader line through
+  // another label the next worst: they count as many hits.
+  constexpr int kOverLabel = 100, kLeaderThroughLabel = 10;
+  for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0, 160.0, 200.0, 250.0}) {
+    for (int direction = 0; direction < 16; ++direction) {
+      // E, W, N, S, NE, SE, NW, SW first, then the eight between them.
+      static constexpr double kAngleDeg[16] = {0,    180,   90,    270,   45,    315,   135,  225,
+                                               22.5, 157.5, 67.5,  112.5, 202.5, 247.5, 292.5, 337.5};
+      const double c = std::cos(kAngleDeg[direction] * std::numbers::pi / 180);
+      const double s = std::sin(kAngleDeg[direction] * std::numbers::pi / 180);
+      const int hx = c > 0.3 ? 1 : c < -0.3 ? -1 : 0;
+      const int vy = s > 0.3 ? -1 : s < -0.3 ? 1 : 0;
+      // The first eight as they always were (diagonals at 0.7 d).
+      const double along = direction < 8 && hx != 0 && vy != 0 ? 0.7 : 1.0;
+      const double px = ax + d * (direction < 8 ? along * hx : c), py = ay + d * (direction < 8 ? along * vy : -s);
+      const double left = hx > 0 ? px : hx < 0 ? px - width : px - width / 2;
+      const double top = vy > 0 ? py : vy < 0 ? py - height : py - height / 2;
       const Box box{left, top, left + width, top + height};
       if (!box.Inside(area)) continue;
       int hits = 0;
       for (const Box& m : marks) hits += box.Overlaps(m);
       for (const Segment& a : arrows) hits += Crosses(a, box);
-      for (const Box& l : labels) hits += 2 * box.Overlaps(l);
+      for (const Box& l : labels) hits += kOverLabel * box.Overlaps(l);
       if (d <= kLeaderFromPx) {
         const double own = Distance(ax, ay, box);
         for (const auto& [x, y] : points) hits += Distance(x, y, box) < own + 6;
       } else {  // its leader line must not run through a label placed before
         const Segment leader{ax, ay, std::clamp(ax, box.x0, box.x1), std::clamp(ay, box.y0, box.y1)};
-        for (const Box& l : labels) hits += 2 * Crosses(leader, l);
+        for (const Box& l : labels) hits += kLeaderThroughLabel * Crosses(leader, l);
       }
       if (hits == 0) return box;
       if (best_hits < 0 || hits < best_hits) {
