@@ -477,7 +477,7 @@ Box PlaceLabel(double ax, double ay, double width, const Box& area, const std::v
   // Text over text is the worst a label can do, a leader line through
   // another label the next worst: they count as many hits.
   constexpr int kOverLabel = 100, kLeaderThroughLabel = 10;
-  for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0, 160.0, 200.0, 250.0}) {
+  for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0}) {
     for (int direction = 0; direction < 16; ++direction) {
       // E, W, N, S, NE, SE, NW, SW first, then the eight between them.
       static constexpr double kAngleDeg[16] = {0,    180,   90,    270,   45,    315,   135,  225,
