@@ -158,6 +158,12 @@ inline constexpr double kDiffDefaultThresholdUm = 10;
 // which gives up beyond kDiffMaxEditDistance edits in one function.
 inline constexpr double kDiffMaxAlignCells = 4e6;
 inline constexpr long kDiffMaxEditDistance = 2000;
+// The board poses the diff evaluates a fixture target at (calibration/
+// machine_model.h) lie this fraction of the way to the fixture's check
+// limits (max_shift_mm, max_rotation_deg): at the limits themselves a
+// runtime whose estimate differs from the board's true pose by micrometres
+// (a re-measured marker table) would refuse the scan on one side only.
+inline constexpr double kDiffPoseLimitFraction = 0.99;
 
 // A table's error "changes sign between neighbouring nodes" (the paper's
 // condition for linear interpolation, warned by table check) only where both
