@@ -38,6 +38,35 @@ const Region* Cell::RegionAt(const Point2& p) const {
   return nullptr;
 }
 
+namespace {
+constexpr std::string_view kCellFileMark = "cell file sha256 ";
+constexpr std::string_view kTableFileMark = "table file sha256 ";
+constexpr std::size_t kSha256HexDigits = 64;
+}  // namespace
+
+std::string CellFileLine(const CellFile& file) {
+  return std::string(file.table ? kTableFileMark : kCellFileMark) + file.sha256 + " " + file.path;
+}
+
+std::optional<CellFile> ParseCellFileLine(std::string_view text) {
+  CellFile file;
+  if (text.starts_with(kTableFileMark)) {
+    file.table = true;
+    text.remove_prefix(kTableFileMark.size());
+  } else if (text.starts_with(kCellFileMark)) {
+    text.remove_prefix(kCellFileMark.size());
+  } else {
+    return std::nullopt;
+  }
+  if (text.size() < kSha256HexDigits + 2 || text[kSha256HexDigits] != ' ') return std::nullopt;
+  for (char c : text.substr(0, kSha256HexDigits)) {
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return std::nullopt;
+  }
+  file.sha256 = std::string(text.substr(0, kSha256HexDigits));
+  file.path = std::string(text.substr(kSha256HexDigits + 1));
+  return file;
+}
+
 std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot) {
   if (!robot.uncalibrated_accuracy_mm) return std::nullopt;
   return DeclaredRoughness{*robot.uncalibrated_accuracy_mm, robot.uncalibrated_correlation_mm};

@@ -126,6 +126,7 @@ struct Region {
   // table yet: then has_table is false, the table and domain are empty, and
   // the bounds are as written.
   bool has_table = true;
+  std::uint32_t table_file = 0;  // the table file's SourceManager id (0: not read from a file)
   ErrorTable table;
   Rect domain;             // TableDomain(table): where F is defined
   // How far the robot's error may depart from the table's interpolation
@@ -347,6 +348,23 @@ inline constexpr int kLinuxCncMaxDio = 64;
 // ... and at most 64 analog inputs and outputs (motion.analog-in/out-NN, [EMCMOT]num_aio).
 inline constexpr int kLinuxCncMaxAio = 64;
 
+// A file a cell was read from, with the SHA-256 of its bytes (base/sha256.h):
+// what a compiled program records of the cell it was compiled for, so
+// `smtcal diff` can tell whether a cell is that one (docs/diff.md).
+struct CellFile {
+  bool table = false;        // an error table (else the cell file itself)
+  std::string path;          // the cell file as given; a table as the cell file writes it
+  std::string sha256;        // 64 lowercase hex digits
+  std::vector<std::string> regions;  // a table: the regions that use it, in cell order
+};
+
+// How a compiled output records one of its cell's files, in a comment line
+// (docs/diff.md): "cell file sha256 <64 hex digits> <path>" or "table file
+// sha256 <64 hex digits> <path>". The regions are not part of it.
+std::string CellFileLine(const CellFile& file);
+// The inverse, for the text of such a comment; nullopt for anything else.
+std::optional<CellFile> ParseCellFileLine(std::string_view text);
+
 struct Cell {
   std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
   std::string path;    // the cell file as given
@@ -357,6 +375,10 @@ struct Cell {
   std::vector<Feeder> feeders;
   std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
   std::optional<Measure> measure;    // the [measure] table, when the file has one
+  // The cell file, then each table file once, in the order the regions name
+  // them: set by the loader (and by the reader of a LinuxCNC output, from
+  // what the compile wrote there).
+  std::vector<CellFile> files;
 
   const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
   const Region* FindRegion(std::string_view name) const;    // case-insensitive

@@ -49,6 +49,16 @@ std::string LineRanges(const std::vector<RawMeasurement>& measurements, const st
 
 std::string Um(double mm) { return fmt::format("{:.1f}", mm * kUmPerMm); }
 
+// How far above the axis's pooled scatter a node's sample stddev of `dof`
+// degrees of freedom may lie by chance at kNoisyNodeMadFactor sigma: the
+// square root of the chi-square quantile over its degrees of freedom
+// (Wilson-Hilferty's approximation, a little above the exact quantile:
+// 5.5 for one degree of freedom where the exact is 5.1, 1.9 for 19).
+double ChiSquareScatterFactor(double dof) {
+  const double c = 1 - 2 / (9 * dof) + kNoisyNodeMadFactor * std::sqrt(2 / (9 * dof));
+  return std::sqrt(c * c * c);
+}
+
 void WarnNoisyNodes(const std::vector<RawMeasurement>& measurements, const std::vector<NodeSummary>& nodes,
                     Diagnostics& diags) {
   for (TableAxis axis : kTableAxes) {
@@ -61,9 +71,32 @@ void WarnNoisyNodes(const std::vector<RawMeasurement>& measurements, const std::
     std::vector<double> deviations;
     for (double s : spreads) deviations.push_back(std::abs(s - median));
     const double mad = Median(deviations);
-    const double limit = median + std::max(kNoisyNodeMadFactor * kMadToSigma * mad, kNoisyNodeFloorMm);
+    const double robust_limit = median + std::max(kNoisyNodeMadFactor * kMadToSigma * mad, kNoisyNodeFloorMm);
+    // The median says little when a node has few readings: readings in a
+    // device's steps (a probe latching a servo period's travel) with two
+    // repetitions give most nodes no scatter at all and the rest one step.
+    // A node is also held to the chi-square bound of its own readings
+    // against the other nodes' pooled scatter, so one step apart is not
+    // "noisy".
+    double sum_squares = 0, sum_dof = 0;
     for (const NodeSummary& node : nodes) {
-      if (node.axis != axis || !node.pooled_stddev_mm || *node.pooled_stddev_mm <= limit) continue;
+      if (node.axis != axis || !node.pooled_stddev_mm || node.rows.size() < 2) continue;
+      const double dof = static_cast<double>(node.rows.size() - 1);
+      sum_squares += dof * *node.pooled_stddev_mm * *node.pooled_stddev_mm;
+      sum_dof += dof;
+    }
+    for (const NodeSummary& node : nodes) {
+      if (node.axis != axis || !node.pooled_stddev_mm || node.rows.size() < 2) continue;
+      // The pooled scatter of the other nodes: a noisy node must not widen
+      // its own yardstick.
+      const double dof = static_cast<double>(node.rows.size() - 1);
+      const double others_dof = sum_dof - dof;
+      const double others = others_dof > 0 ? std::sqrt(std::max(0.0, sum_squares - dof * *node.pooled_stddev_mm *
+                                                                                    *node.pooled_stddev_mm) /
+                                                       others_dof)
+                                           : 0.0;
+      const double limit = std::max(robust_limit, others * ChiSquareScatterFactor(dof));
+      if (*node.pooled_stddev_mm <= limit) continue;
       const RawMeasurement& first = measurements[node.rows.front()];
       Diagnostic* diag = diags.Report(DiagKind::RawNoisyNode, first.error_field, FormatMm(node.x_mm),
                                       FormatMm(node.y_mm), AxisName(axis), Um(*node.pooled_stddev_mm),

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -240,6 +241,19 @@ double PitchForShare(double pitch_mm, double part_mm, double allowed_mm) {
   if (!(allowed_mm > 0)) return 0;
   if (!(part_mm > allowed_mm)) return pitch_mm;
   return std::floor(10 * pitch_mm * std::sqrt(allowed_mm / part_mm)) / 10;
+}
+
+double PlannedInterpolationMm(const DeclaredRoughness& roughness, double pitch_mm) {
+  return std::numbers::sqrt2 * DeclaredFigure(roughness, roughness.accuracy_mm, pitch_mm);
+}
+
+double PlannedPitchMm(const DeclaredRoughness& roughness, double tolerance_mm) {
+  const double allowed = kInterpolationShareOfTolerance * tolerance_mm;
+  // Per axis: A (1 - cos(pi h / 3L)) <= allowed / sqrt(2).
+  const double cosine = 1 - allowed / (std::numbers::sqrt2 * roughness.accuracy_mm);
+  if (!(cosine > -1)) return std::numeric_limits<double>::infinity();
+  const double wavelength = kRoughnessWavelengthPerCorrelation * roughness.correlation_mm;
+  return std::floor(10 * wavelength / std::numbers::pi * std::acos(cosine)) / 10;
 }
 
 GridAdvice AdviseGrid(const InterpolationEstimate& estimate, double tolerance_mm) {

@@ -169,6 +169,20 @@ GridAdvice AdviseGrid(const InterpolationEstimate& estimate, double tolerance_mm
 void ReportCoarseGrid(const InterpolationEstimate& estimate, double tolerance_mm, std::string_view subject,
                       const SourceRange& where, Diagnostics& diags);
 
+// The estimate of a grid not measured yet, at pitch `pitch_mm`, in a cell
+// that declares (or assumes) this roughness: its nodes can rule nothing out
+// yet, so every cell carries the declared wave at its full amplitude A, per
+// axis A (1 - cos(pi h / 3L)) (what EstimateInterpolationError gives a cell
+// without a check point whose nodes hide the wave), and the estimate is the
+// length of (E_x, E_y).
+double PlannedInterpolationMm(const DeclaredRoughness& roughness, double pitch_mm);
+
+// The grid advice before the first measurement (`measure plan`'s default
+// pitch): the largest pitch at which PlannedInterpolationMm is within
+// kInterpolationShareOfTolerance of `tolerance_mm`, rounded down to 0.1 mm;
+// infinity when no pitch can exceed it (the whole declared range fits).
+double PlannedPitchMm(const DeclaredRoughness& roughness, double tolerance_mm);
+
 // The pitch at which an interpolation part of `part_mm` (at pitch
 // `pitch_mm`) would shrink to `allowed_mm`, rounded down to 0.1 mm (the
 // error scales with the pitch squared); 0 when nothing is allowed.

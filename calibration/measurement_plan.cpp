@@ -11,6 +11,7 @@
 #include "base/check.h"
 #include "base/field_text.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/motion_time.h"
 
 namespace smtcal::measure {
@@ -28,34 +29,6 @@ double RoundPitchDown(double limit) {
     if (step * decade <= limit * (1 + 1e-12)) best = step * decade;
   }
   return best;
-}
-
-// How far the bilinear interpolation of a field with curvature `curvature`
-// (1/mm) departs from it at a cell's centre, per pitch squared: h^2/8 * |f''|.
-double PitchForCurvature(double curvature_per_mm, double allowed_mm) {
-  return std::sqrt(8.0 * allowed_mm / curvature_per_mm);
-}
-
-// The largest second difference of a previous table per pitch squared, over
-// both axes and both directions: its curvature where it was measured.
-double TableCurvature(const ErrorTable& table) {
-  double worst = 0;
-  for (TableAxis axis : kTableAxes) {
-    const AxisTable& t = table[axis];
-    for (std::size_t j = 0; j < t.ny(); ++j) {
-      for (std::size_t i = 1; i + 1 < t.nx(); ++i) {
-        double h = 0.5 * (t.xs[i + 1] - t.xs[i - 1]);
-        worst = std::max(worst, std::abs(t.At(i + 1, j) - 2 * t.At(i, j) + t.At(i - 1, j)) / (h * h));
-      }
-    }
-    for (std::size_t j = 1; j + 1 < t.ny(); ++j) {
-      for (std::size_t i = 0; i < t.nx(); ++i) {
-        double h = 0.5 * (t.ys[j + 1] - t.ys[j - 1]);
-        worst = std::max(worst, std::abs(t.At(i, j + 1) - 2 * t.At(i, j) + t.At(i, j - 1)) / (h * h));
-      }
-    }
-  }
-  return worst;
 }
 
 // Grid lines covering [lo - margin, hi + margin] at `pitch`, centred on the
@@ -296,27 +269,37 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
     region.sets = options.sets;
     region.repetitions = options.repetitions;
     region.margin_mm = accuracy;
-    // The pitch: given, or the largest round one whose interpolation error
-    // stays within kPlanInterpolationShare of the tolerance.
-    const double allowed = kPlanInterpolationShare * region.tolerance_mm;
+    // The pitch: given, or from the interpolation-error estimate verify
+    // uses (calibration/interpolation_error.h): the grid advice of the
+    // previous table, or before any table the planned estimate of the
+    // declared roughness; then the largest round pitch not above it.
+    const double share = 100 * kInterpolationShareOfTolerance;
     if (options.pitch_mm) {
       region.pitch_mm = *options.pitch_mm;
       region.pitch_reason = "given (--pitch)";
-    } else if (source != nullptr && source->has_table && TableCurvature(source->table) > 0) {
-      const double curvature = TableCurvature(source->table);
-      region.pitch_mm = RoundPitchDown(PitchForCurvature(curvature, allowed));
+    } else if (source != nullptr && source->has_table) {
+      const InterpolationEstimate& previous = source->interpolation;
+      const GridAdvice advice = AdviseGrid(previous, region.tolerance_mm);
+      const double advised = advice.coarse ? advice.pitch_mm : previous.PitchMm();
+      region.pitch_mm = RoundPitchDown(std::max(advised, kPlanSmallestPitchMm));
       region.pitch_reason = fmt::format(
-          "from the previous table {}: its curvature {:.2g} /mm keeps the interpolation error within {:.0f} % of the "
-          "tolerance (±{} mm)",
-          source->table_path, curvature, 100 * kPlanInterpolationShare, Mm(region.tolerance_mm));
+          "from the previous table {}: between its nodes ({} mm apart) {:.4f} mm, {}, {:.0f} % of the tolerance "
+          "±{} mm; {}",
+          source->table_path, Mm(previous.PitchMm()), previous.NormMm(), InterpolationKindShortName(previous.Kind()),
+          100 * advice.share, Mm(region.tolerance_mm),
+          advice.coarse ? fmt::format("within {:.0f} % at {} mm or less", share, Mm(advice.pitch_mm))
+                        : fmt::format("within {:.0f} %: its pitch again", share));
     } else {
-      const double curvature = accuracy / (robot.uncalibrated_correlation_mm * robot.uncalibrated_correlation_mm);
-      region.pitch_mm = RoundPitchDown(PitchForCurvature(curvature, allowed));
+      const DeclaredRoughness roughness{accuracy, robot.uncalibrated_correlation_mm};
+      const double span = std::max(region.x_mm.hi - region.x_mm.lo, region.y_mm.hi - region.y_mm.lo) +
+                          2 * region.margin_mm;
+      const double planned = std::min(PlannedPitchMm(roughness, region.tolerance_mm), span);
+      region.pitch_mm = RoundPitchDown(std::max(planned, kPlanSmallestPitchMm));
       region.pitch_reason = fmt::format(
-          "from the tolerance ±{} mm: an error of {} mm changing over {} mm (robot.uncalibrated_*) interpolated "
-          "within {:.0f} % of it",
-          Mm(region.tolerance_mm), Mm(accuracy), Mm(robot.uncalibrated_correlation_mm),
-          100 * kPlanInterpolationShare);
+          "from the declared roughness (robot.uncalibrated_* keys: {} mm over 3 x {} mm), which nodes not yet "
+          "measured cannot rule out: between the nodes {:.4f} mm, within {:.0f} % of the tolerance ±{} mm",
+          Mm(accuracy), Mm(robot.uncalibrated_correlation_mm), PlannedInterpolationMm(roughness, region.pitch_mm),
+          share, Mm(region.tolerance_mm));
     }
     // The artefact's lattice: the transducer's grooves, the probe's holes.
     std::optional<double> lattice;

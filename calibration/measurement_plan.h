@@ -33,14 +33,16 @@ std::string_view MeasuredAxesName(MeasuredAxes axes);  // x | y | xy
 enum class VisitKind { kNode, kCheck };
 std::string_view VisitKindName(VisitKind kind);  // node | check
 
-// The default pitch (without --pitch): the largest round pitch (1, 2, 2.5 or
-// 5 x 10^k mm) at which the bilinear interpolation of a smooth error field
-// stays within this share of the region's tolerance: the error field assumed
-// changes by robot.uncalibrated_accuracy_mm over robot.uncalibrated_correlation_mm
-// (its curvature about accuracy / correlation^2, interpolation error at a
-// cell's centre about pitch^2 / 8 times that), or, given a previous table,
-// that table's own interpolation-error estimate scaled with the pitch squared.
-inline constexpr double kPlanInterpolationShare = 0.1;
+// The default pitch (without --pitch) comes from the interpolation-error
+// estimate verify budgets (calibration/interpolation_error.h), the pitch at
+// which it is kInterpolationShareOfTolerance of the region's tolerance: with
+// a previous table, that table's grid advice (AdviseGrid of the region's
+// estimate; its own pitch again when it is within the share); before any
+// table, PlannedPitchMm of the declared roughness (robot.uncalibrated_*),
+// which nodes not measured yet cannot rule out. Then the largest round pitch
+// (1, 2, 2.5 or 5 x 10^k mm) not above it, and onto the artefact's lattice.
+// Never below this (a tolerance of nothing would ask for a pitch of 0).
+inline constexpr double kPlanSmallestPitchMm = 0.1;
 // Without robot.uncalibrated_accuracy_mm the plan assumes this error (the
 // paper's robot after its gripper was mounted) and says so.
 inline constexpr double kPlanAssumedAccuracyMm = 0.25;

@@ -62,7 +62,10 @@ inline constexpr double kMaxErrorPitchFraction = 0.5;
 // `table build` flags a node whose repetition scatter (pooled stddev) is above
 // median + kNoisyNodeMadFactor * 1.4826 * MAD of its axis's nodes (a robust
 // 5-sigma) and at least kNoisyNodeFloorMm (the transducers' resolution) above
-// the median, so a table of perfectly repeatable nodes does not flag noise.
+// the median, so a table of perfectly repeatable nodes does not flag noise;
+// and above the chi-square bound (at the same 5 sigma) of its own number of
+// readings against its axis's pooled scatter, so a node of two readings one
+// device step apart is not flagged where most nodes show no scatter at all.
 inline constexpr double kNoisyNodeMadFactor = 5.0;
 inline constexpr double kNoisyNodeFloorMm = 0.001;
 // ... and a node whose set means differ by more than kSetShiftFactor standard
@@ -155,6 +158,12 @@ inline constexpr double kDiffDefaultThresholdUm = 10;
 // which gives up beyond kDiffMaxEditDistance edits in one function.
 inline constexpr double kDiffMaxAlignCells = 4e6;
 inline constexpr long kDiffMaxEditDistance = 2000;
+// The board poses the diff evaluates a fixture target at (calibration/
+// machine_model.h) lie this fraction of the way to the fixture's check
+// limits (max_shift_mm, max_rotation_deg): at the limits themselves a
+// runtime whose estimate differs from the board's true pose by micrometres
+// (a re-measured marker table) would refuse the scan on one side only.
+inline constexpr double kDiffPoseLimitFraction = 0.99;
 
 // A table's error "changes sign between neighbouring nodes" (the paper's
 // condition for linear interpolation, warned by table check) only where both

@@ -24,6 +24,7 @@
 #include <toml++/toml.h>
 
 #include "base/field_text.h"
+#include "base/sha256.h"
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
@@ -157,6 +158,7 @@ class Loader {
     bool missing = false;                 // ... because it does not exist
     bool ok = false;                      // read and valid
     ErrorTable table;
+    std::uint32_t file = 0;               // its SourceManager id, when read
   };
   using Names = std::vector<Located<std::string>>;
 
@@ -181,6 +183,8 @@ class Loader {
   void CheckRegionOverlaps(const std::vector<Region>& regions);
   void CheckTrueFieldGrid(const Robot& robot, Keys& keys);
   void CheckUniqueNames(const Names& names, std::string_view noun);
+  // cell.files: the cell file and its tables with their SHA-256.
+  void RecordFiles(Cell& cell) const;
 
   // Robot-limit checks; `robot_ok_` says whether [robot] was read cleanly.
   void CheckInLimit(int axis, double value, SourceRange where, const std::string& subject);
@@ -577,6 +581,7 @@ const Loader::LoadedTable& Loader::LoadTable(const std::string& table_path) {
     loaded.missing = !std::filesystem::exists(resolved, error) && !error;
     return loaded;
   }
+  loaded.file = file.value();
   std::optional<ErrorTable> table = ReadErrorTable(file.value(), diags_);
   // Warnings (sign changes, large errors): `smtcal table check` shows each, and
   // ReportTableWarnings sums them up for the commands that decide.
@@ -660,6 +665,7 @@ std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
       } else if (!loaded->ok) {
         diags_.Report(DiagKind::CellTableInvalid, path->range, Printable(path->value), Printable(region.name));
       }
+      region.table_file = loaded->file;
     }
   }
 
@@ -1269,7 +1275,22 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
     // A region planned for measuring has no table yet: nothing to estimate.
     if (region.has_table) region.interpolation = RegionInterpolation(cell.robot, region.table);
   }
+  RecordFiles(cell);
   return cell;
+}
+
+void Loader::RecordFiles(Cell& cell) const {
+  cell.files.push_back({false, cell.path, Sha256Hex(sources_.File(file_).text), {}});
+  for (const Region& region : cell.regions) {
+    if (!region.has_table) continue;  // planned for measuring: no table file yet
+    auto same = std::find_if(cell.files.begin() + 1, cell.files.end(),
+                             [&](const CellFile& file) { return file.path == region.table_path; });
+    if (same == cell.files.end()) {
+      cell.files.push_back({true, region.table_path, Sha256Hex(sources_.File(region.table_file).text), {}});
+      same = cell.files.end() - 1;
+    }
+    same->regions.push_back(region.name);
+  }
 }
 
 // "Error while parsing key-value pair: expected ..." -> "expected ... (while parsing key-value pair)".

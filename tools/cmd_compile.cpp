@@ -49,6 +49,8 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
       " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
       " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
   };
+  // The cell and table files it was compiled with: `smtcal diff` finds and checks them by these.
+  for (const cell::CellFile& file : cell.files) lines.push_back(" " + cell::CellFileLine(file));
   ir::Block header;
   for (const std::string& line : lines) {
     auto stmt = std::make_unique<ir::Stmt>();

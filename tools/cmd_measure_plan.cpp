@@ -70,15 +70,16 @@ void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options) {
   CLI::App* plan = measure.add_subcommand(
       "plan",
       "Plan the measurement of the cell's regions (and of the markers' when the cell lacks them): per region the\n"
-      "grid over its bounds and a margin for the robot's error, the pitch (default: from the tolerance, or from\n"
-      "the region's previous table when it exists), check points between nodes, sets x repetitions (the paper's\n"
+      "grid over its bounds and a margin for the robot's error, the pitch (default: where verify's estimate of\n"
+      "the interpolation error is 10 % of the tolerance: from the robot's declared roughness, or from the grid\n"
+      "advice of the region's previous table when it exists), check points between nodes, sets x repetitions (the paper's\n"
       "2 x 10), every node reached by the robot's final approach, in serpentine order; prints the summary and\n"
       "the time at the cell's speeds. A region whose table file does not exist yet needs its bounds x_mm, y_mm");
   plan->add_option("--cell", opt.cell, "the cell file ([measure] describes the device)")->required();
   plan->add_option("-o,--output", opt.output, "the plan to write (CSV; '-' for stdout)")->required();
   plan->add_option("--region", opt.regions, "measure only this region (repeatable; default: every region)");
   AddNumberOption(*plan, "--pitch", opt.pitch_mm,
-                  "the grid pitch in mm (default: from the tolerance or the previous table)", limits::kMeasurePitchMm);
+                  "the grid pitch in mm (default: the interpolation estimate's, from the declared roughness or the previous table)", limits::kMeasurePitchMm);
   AddNumberOption(*plan, "--sets", opt.sets, "sets of repetitions per node (the paper: 2)", limits::kMeasureSets)
       ->capture_default_str();
   AddNumberOption(*plan, "--repetitions", opt.repetitions, "repetitions per node and set (the paper: 10)",

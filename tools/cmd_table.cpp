@@ -1,16 +1,20 @@
-// `smtcal table build|check|stats|forward|inverse|plot`: the error tables of
-// a calibrated region (docs/error-tables.md). The work is in
+// `smtcal table build|check|stats|forward|inverse|plot|diff`: the error
+// tables of a calibrated region (docs/error-tables.md). The work is in
 // frontend/table_csv, passes/error_table*, passes/inverse_calibration and
 // backend/table_*; this file only wires files, options and exit codes.
 #include <filesystem>
 #include <optional>
 
+#include "backend/reports/table_diff_report.h"
 #include "backend/reports/table_plot.h"
 #include "backend/reports/table_report.h"
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
 #include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
+#include "calibration/table_diff.h"
+#include "calibration/tolerances.h"
+#include "frontend/cell_toml.h"
 #include "calibration/limits.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
@@ -29,6 +33,12 @@ struct TableOptions {
   double paper_tolerance_mm = kPaperSolverTolMm;
   double tolerance_mm = kDefaultTableToleranceMm;  // check, stats: what the interpolation error is a share of
   bool drop_outlier_readings = false;
+  // table diff
+  std::string new_input;
+  std::string cell;
+  std::string svg;
+  double threshold_um = kDiffDefaultThresholdUm;
+  bool exit_zero = false;
 };
 
 std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
@@ -200,6 +210,57 @@ void RunPlot(const TableOptions& opt, GlobalOptions& options) {
   Finish(diags, options, opt.output, PlotTableSvg(*table, BaseName(table->name)));
 }
 
+void RunDiff(const TableOptions& opt, GlobalOptions& options) {
+  if (FilesClash({{"A", opt.input}, {"B", opt.new_input}, {"--cell", opt.cell}},
+                 {{"--svg", opt.svg}, {"the diff", "-"}})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<ErrorTable> old_table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
+  if (!old_table) return;
+  std::optional<ErrorTable> new_table = LoadTable(opt.new_input, sources, diags, TableWarnings::kSkip, options);
+  if (!new_table) return;
+  std::optional<cell::Cell> cell;
+  if (!opt.cell.empty()) {
+    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
+    if (!loaded) {
+      PrintDiagnostics(diags, options);
+      options.exit_code = ReportIoError(loaded.error());
+      return;
+    }
+    if (!loaded.value()) {
+      options.exit_code = PrintDiagnostics(diags, options);
+      return;
+    }
+    cell = std::move(loaded).value();
+  }
+  const TableChanges changes =
+      CompareTables(*old_table, *new_table, opt.threshold_um, cell ? &cell->regions : nullptr);
+  const TableDiffNames names{opt.input, opt.new_input, opt.cell};
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (options.exit_code != kExitOk) return;
+  if (!opt.svg.empty()) {
+    const std::string svg = PlotTableDiffSvg(*old_table, *new_table, names);
+    if (svg.empty()) {
+      options.exit_code = ReportInputError("the tables share no area of 2 x 2 nodes to draw; no --svg written");
+      return;
+    }
+    if (Status written = WriteFileAtomically(opt.svg, svg); !written) {
+      options.exit_code = ReportIoError(written.error());
+      return;
+    }
+  }
+  const std::string text = opt.json ? FormatTableDiffJson(changes, names) : FormatTableDiffText(changes, names);
+  if (Status written = WriteFileAtomically("-", text); !written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  if (!opt.svg.empty()) SayDone(options, opt.svg, fmt::format("wrote the picture {}", opt.svg));
+  options.exit_code = TableDiffPasses(changes) || opt.exit_zero ? kExitOk : kExitInputError;
+}
+
 void AddToleranceOption(CLI::App& command, TableOptions& opt) {
   AddNumberOption(command, "--tolerance", opt.tolerance_mm,
                   "the placing tolerance (mm) the interpolation error between the nodes is a share of; above "
@@ -286,6 +347,22 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   plot->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
   plot->add_option("-o,--output", opt.output, "the SVG file to write ('-' for stdout)")->required();
   plot->callback([&options] { RunPlot(opt, options); });
+
+  CLI::App* diff = table->add_subcommand(
+      "diff", "Compare two error tables of a region (before and after re-measuring): every node's change per axis\n"
+              "(grids may differ: each node against the other table's interpolation on the common area), the\n"
+              "largest, mean and rms change, the nodes that changed most, per region with --cell; exit 1 when a\n"
+              "node changed by more than --threshold");
+  diff->add_option("A", opt.input, "the table in use now (CSV; '-' for stdin)")->required();
+  diff->add_option("B", opt.new_input, "the re-measured table (CSV; '-' for stdin)")->required();
+  diff->add_option("--cell", opt.cell, "a cell file: the changes within each of its regions' bounds too");
+  AddNumberOption(*diff, "--threshold", opt.threshold_um,
+                  "the gate: a node whose error changed by more than this many µm fails it", limits::kDiffThresholdUm)
+      ->capture_default_str();
+  diff->add_flag("--json", opt.json, "print JSON (schema smtcal-table-diff/1) instead of text");
+  diff->add_option("--svg", opt.svg, "also draw the change as an SVG file: colour maps of both axes in µm and arrows");
+  diff->add_flag("--exit-zero", opt.exit_zero, "report only: exit 0 even when the gate fails");
+  diff->callback([&options] { RunDiff(opt, options); });
 }
 
 }  // namespace smtcal::tools

@@ -310,6 +310,8 @@ std::string DataText(const cell::Cell& cell, std::optional<long> id) {
       "; numbered parameters #{}..#{} (layout: runtime/linuxcnc/README.md) and marks every\n"
       "; fixture not scanned yet. Lengths mm, angles degrees, base frame.\n",
       CommentText(cell.name), CommentText(cell.path), SMTCAL_VERSION, L::kFirst, layout.next() - 1);
+  // The files the data came from: `smtcal diff` names them.
+  for (const cell::CellFile& file : cell.files) out += fmt::format("; {}\n", CommentText(cell::CellFileLine(file)));
   out += "o<smtcal_data> sub\n";
   out += fmt::format("#{} = 0  ; not loaded while loading\n", L::kVersion);
   out += fmt::format("#{} = {}  ; region count\n", L::kRegionCount, cell.regions.size());

@@ -213,6 +213,16 @@ std::string VerifySummaryText(const ir::Program& program, const CompileState& st
   if (!interpolation.empty()) {
     text += fmt::format("  interpolation between the table nodes (mm, budget part `interpolation`): {}\n", interpolation);
   }
+  // Backlash has no part in the budget (docs/measure.md, "Backlash"): say so
+  // where it can move a placement, on fixture targets through the scan.
+  if (state.cell->robot.final_approach_mm && by_kind[CorrectionKind::kFixture] > 0) {
+    const Eigen::Vector2d& approach = *state.cell->robot.final_approach_mm;
+    text += fmt::format(
+        "  not in the budget: backlash. Targets reached by the final approach ({}, {}) mm carry the backlash their "
+        "tables measured; a scan trip whose leg runs against that approach may be off by up to an axis's backlash "
+        "across its edge, which moves every placement on the board (docs/measure.md, \"Backlash\")\n",
+        FormatMm(approach.x()), FormatMm(approach.y()));
+  }
   const auto process = PredictedCapability(state);
   if (!process.empty()) {
     text += "  process, from the budget's model (normal assumption):\n";

@@ -256,6 +256,38 @@ TEST(InterpolationError, GridAdviceScalesWithThePitchSquared) {
   EXPECT_DOUBLE_EQ(PitchForShare(20, 0.04, -0.01), 0.0);
 }
 
+// Before the first measurement (measure plan's default pitch): the planned
+// estimate is what EstimateInterpolationError gives a flat 3 x 3 table at
+// that pitch (its nodes rule nothing out, as unmeasured ones do), and the
+// planned pitch is the largest 0.1 mm step within the share of the
+// tolerance. The example's robot: 0.25 mm over 25 mm, +-0.1 mm: 5.6 mm
+// (0.0077 mm at 5 mm, the paper's pitch).
+TEST(InterpolationError, ThePlannedPitchIsTheDeclaredEstimatesGridAdvice) {
+  const Field zero = [](double, double) { return 0.0; };
+  const DeclaredRoughness example{0.25, 25};
+  EXPECT_DOUBLE_EQ(PlannedPitchMm(example, 0.1), 5.6);
+  EXPECT_NEAR(PlannedInterpolationMm(example, 5), 0.0077, 5e-5);
+  std::mt19937_64 rng(test::FixtureSeed());
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", test::FixtureSeed()));
+  for (int trial = 0; trial < 200; ++trial) {
+    const DeclaredRoughness r{test::Uniform(rng, 0.01, 0.5), test::Uniform(rng, 5, 100)};
+    const double tolerance = test::Uniform(rng, 0.02, 0.2);
+    const double pitch = PlannedPitchMm(r, tolerance);
+    const double allowed = kInterpolationShareOfTolerance * tolerance;
+    if (std::isinf(pitch)) {
+      // No wave of the declared range departs more than the share.
+      EXPECT_LE(2 * std::numbers::sqrt2 * r.accuracy_mm, allowed * (1 + 1e-12));
+      continue;
+    }
+    EXPECT_LE(PlannedInterpolationMm(r, pitch), allowed * (1 + 1e-12)) << trial;
+    EXPECT_GT(PlannedInterpolationMm(r, pitch + 0.1), allowed) << trial;
+    const ErrorTable flat = Measure(zero, zero, pitch, 3, nullptr, false);
+    EXPECT_NEAR(EstimateInterpolationError(flat, r, 0).NormMm(), PlannedInterpolationMm(r, pitch), 1e-15) << trial;
+  }
+  // Declared smoother than the share: any pitch.
+  EXPECT_TRUE(std::isinf(PlannedPitchMm(DeclaredRoughness{0.001, 25}, 0.1)));
+}
+
 // The property: random smooth fields whose shortest wavelength is 2.5
 // pitches or more, at 2, 5, 10 and 25 mm pitch, measured with the paper's
 // noise, large (0.25 mm) and small (5 µm) amplitudes; check points at every

@@ -85,17 +85,24 @@ TEST(MeasurementPlan, ThePapersCellGetsItsGridAndDefaults) {
   EXPECT_GT(plan->time_s, 0);
 }
 
-TEST(MeasurementPlan, DefaultPitchFollowsTheToleranceAndThePreviousTable) {
+TEST(MeasurementPlan, DefaultPitchIsTheInterpolationEstimatesGridAdvice) {
   SourceManager sources_diags;
   Diagnostics diags(sources_diags);
   cell::Cell c = TestCell(cell::MeasureDevice::kProbe, {150.5, 199.5}, {60.5, 109.5});
   std::optional<Plan> plan = MakePlan(c, PlanOptions{}, diags);
   ASSERT_TRUE(plan) << diags.RenderText();
-  // 0.25 mm over 25 mm, 10 % of 0.1 mm: sqrt(8 * 0.01 / 4e-4) = 14.1 -> 10 mm.
-  EXPECT_DOUBLE_EQ(plan->regions[0].pitch_mm, 10);
-  // A previous table with a gentle curvature allows a coarser grid.
+  // No table yet: the declared roughness (0.25 mm over 25 mm) at 10 % of
+  // 0.1 mm, PlannedPitchMm 5.6 mm, rounded to 5 mm (a lattice step).
+  const DeclaredRoughness declared{0.25, 25};
+  EXPECT_DOUBLE_EQ(PlannedPitchMm(declared, 0.1), 5.6);
+  EXPECT_DOUBLE_EQ(plan->regions[0].pitch_mm, 5);
+  EXPECT_NE(plan->regions[0].pitch_reason.find("declared roughness"), std::string::npos);
+  // A previous table: verify's estimate of it (the region's interpolation)
+  // and its grid advice. A flat 3 x 3 table at 25 mm rules nothing out: the
+  // advice names 5.9 mm, the plan 5 mm.
   cell::Region& region = c.regions[0];
   region.has_table = true;
+  region.table_path = "previous.csv";
   for (TableAxis axis : kTableAxes) {
     AxisTable& t = region.table[axis];
     t.xs = {150, 175, 200};
@@ -105,11 +112,23 @@ TEST(MeasurementPlan, DefaultPitchFollowsTheToleranceAndThePreviousTable) {
       for (std::size_t i = 0; i < 3; ++i) t.error_mm[t.Index(i, j)] = 1e-6 * std::pow(t.xs[i] - 175, 2);
     }
   }
+  region.interpolation = cell::RegionInterpolation(c.robot, region.table);
+  const GridAdvice advice = AdviseGrid(region.interpolation, region.tolerance_mm);
+  ASSERT_TRUE(advice.coarse);
+  EXPECT_DOUBLE_EQ(advice.pitch_mm, 5.9);
   plan = MakePlan(c, PlanOptions{}, diags);
   ASSERT_TRUE(plan) << diags.RenderText();
-  // curvature 2e-6 /mm: sqrt(8 * 0.01 / 2e-6) = 200 -> 200 mm, a 2 x 2 grid.
-  EXPECT_DOUBLE_EQ(plan->regions[0].pitch_mm, 200);
-  EXPECT_NE(plan->regions[0].pitch_reason.find("previous table"), std::string::npos);
+  EXPECT_DOUBLE_EQ(plan->regions[0].pitch_mm, 5);
+  EXPECT_NE(plan->regions[0].pitch_reason.find("previous table previous.csv"), std::string::npos);
+  // Without a declared roughness the same gentle table is fine at its own
+  // curvature (2e-6 /mm: 0.16 µm mid-cell): its pitch again.
+  c.robot.uncalibrated_accuracy_mm.reset();
+  region.interpolation = cell::RegionInterpolation(c.robot, region.table);
+  EXPECT_FALSE(AdviseGrid(region.interpolation, region.tolerance_mm).coarse);
+  plan = MakePlan(c, PlanOptions{}, diags);
+  ASSERT_TRUE(plan) << diags.RenderText();
+  EXPECT_DOUBLE_EQ(plan->regions[0].pitch_mm, 25);
+  EXPECT_NE(plan->regions[0].pitch_reason.find("its pitch again"), std::string::npos);
 }
 
 // Over random regions and pitches: the grid covers the bounds and the

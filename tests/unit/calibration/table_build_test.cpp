@@ -113,6 +113,42 @@ TEST(TableBuild, ANoisyNodeAndAShiftedSetAreReported) {
   }
 }
 
+// A probe reads in steps of a servo period's travel (2 µm): with one set of
+// two readings most nodes show no scatter and the rest one step. None of
+// them is "noisy" (the median scatter is 0 there, and a node of two
+// readings is held to the chi-square bound of two readings); a node whose
+// readings are ten steps apart still is.
+TEST(TableBuild, ReadingsInDeviceStepsRaiseNoAlarmButAFarPairDoes) {
+  for (int k = 0; k < 20; ++k) {
+    const std::uint64_t seed = BaseSeed() + 200 + static_cast<std::uint64_t>(k);
+    SCOPED_TRACE(fmt::format("seed {}", seed));
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0, 0.0008);
+    auto measure = [&](int far) {
+      std::vector<RawMeasurement> raw;
+      for (int node = 0; node < 121; ++node) {
+        const double truth = 0.01 * std::sin(node);
+        for (int rep = 1; rep <= 2; ++rep) {
+          double e = truth + noise(rng) + (node == far && rep == 2 ? 0.02 : 0.0);
+          raw.push_back(M(TableAxis::X, 5.0 * (node % 11), 5.0 * (node / 11), 1, rep, 0.002 * std::round(e / 0.002)));
+          raw.push_back(M(TableAxis::Y, 5.0 * (node % 11), 5.0 * (node / 11), 1, rep, 0.002 * std::round(truth / 0.002)));
+        }
+      }
+      return raw;
+    };
+    SourceManager sources;
+    Diagnostics clean(sources);
+    ASSERT_TRUE(BuildErrorTable("t", measure(-1), SourceLoc{}, clean).has_value()) << clean.RenderText();
+    EXPECT_TRUE(clean.all().empty()) << clean.RenderText();
+    Diagnostics far(sources);
+    ASSERT_TRUE(BuildErrorTable("t", measure(60), SourceLoc{}, far).has_value()) << far.RenderText();
+    ASSERT_EQ(far.all().size(), 1u) << far.RenderText();
+    EXPECT_EQ(far.all()[0].kind, DiagKind::RawNoisyNode);
+    EXPECT_NE(far.all()[0].message.find("node (25.000, 25.000) of the x table"), std::string::npos)
+        << far.all()[0].message;
+  }
+}
+
 // One reading slipped (x10, x1000 or a lost sign): exactly one error, at that
 // reading, naming the slip; the table averaged without it passes its own
 // checks, so nothing else is reported. Left out with the option: one

@@ -125,6 +125,7 @@ std::map<std::string, std::string> BaseCommands(const fs::path& scratch) {
       {"table inverse", fmt::format("table inverse {} {} --solver paper", Q(kGolden / "tables-solve/table.csv"),
                                     Q(kGolden / "tables-solve/paper.csv"))},
       {"table plot", fmt::format("table plot {} -o {}", table, Q(scratch / "t.svg"))},
+      {"table diff", fmt::format("table diff {} {}", table, table)},
       {"compile", fmt::format("compile {} --cell {} -o {}", program, cell, Q(scratch / "c.place"))},
       {"verify", fmt::format("verify {} --cell {}", program, cell)},
       {"fixture", fmt::format("fixture --cell {} --fixture Board --trips {}", Q(kGolden / "fixture/data/board.cell.toml"),
