@@ -320,7 +320,9 @@ std::string DataText(const cell::Cell& cell, std::optional<long> id) {
   out += fmt::format("#{} = {}  ; fixture directory at\n", L::kFixtureDirectory, fixture_directory);
   out += fmt::format("#{} = {}  ; safe z (robot safe_limz_mm)\n", L::kSafeZ, LinuxCncNumber(cell.robot.safe_limz_mm));
   out += fmt::format("#{} = 0  ; a failed check aborts\n", L::kReportOnly);
-  if (id) out += fmt::format("#<_smtcal_runtime_id> = {}  ; this runtime: the main program checks it\n", *id);
+  if (id) {
+    out += fmt::format("{} = {}  ; this runtime: the main program checks it\n", L::kRuntimeIdParameter, *id);
+  }
   out += layout.Text();
   out += fmt::format("#{} = {}  ; loaded: layout version\n", L::kVersion, L::kLayoutVersion);
   out += "o<smtcal_data> endsub\n";

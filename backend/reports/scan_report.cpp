@@ -232,8 +232,12 @@ std::string ScanReportText(const ScanReport& report) {
       out += fmt::format("  {:<13} (the nominal trips give it no pose)\n", name);
       continue;
     }
+    // An unbounded source (a trip where no table and no uncalibrated
+    // accuracy bounds the robot's error) bounds nothing at any point.
+    const bool bounded = std::isfinite(e.worst_mm);
     out += fmt::format("  {:<13} {:>10}  {:>10}  {:>15}  {:>8}  {}\n", name, Fixed(e.sigma.x(), 4),
-                       Fixed(e.sigma.y(), 4), Fixed(e.sigma.z(), 5), Fixed(e.worst_mm, 4), e.worst_at);
+                       Fixed(e.sigma.y(), 4), Fixed(e.sigma.z(), 5), bounded ? Fixed(e.worst_mm, 4) : "unbounded",
+                       bounded ? e.worst_at : "everywhere (`smtcal verify` names the source)");
   }
   out += "  (* the fixture's estimator)\n";
   if (report.suggestions.empty()) {
@@ -285,8 +289,13 @@ std::string ScanReportJson(const ScanReport& report) {
       row["sigma_x_mm"] = RoundedToDecimals(e.sigma.x(), 6);
       row["sigma_y_mm"] = RoundedToDecimals(e.sigma.y(), 6);
       row["sigma_angle_deg"] = RoundedToDecimals(e.sigma.z(), 7);
-      row["worst_mm"] = RoundedToDecimals(e.worst_mm, 6);
-      row["worst_at"] = e.worst_at;
+      if (std::isfinite(e.worst_mm)) {
+        row["worst_mm"] = RoundedToDecimals(e.worst_mm, 6);
+        row["worst_at"] = e.worst_at;
+      } else {
+        row["worst_mm"] = nullptr;  // unbounded
+        row["worst_at"] = nullptr;
+      }
     }
     out["estimators"].push_back(row);
   }

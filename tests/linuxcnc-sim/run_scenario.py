@@ -38,6 +38,7 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
@@ -371,11 +372,33 @@ def trip_paths(binary, work):
     return [trip["path"] for trip in json.loads(result.stdout)["trips"]]
 
 
-def trips_of_cycle(probes, paths, two_stage):
+def scan_path_points(cell_text, fixture="Board"):
+    """Each scan path's points in the base frame at the fixture's nominal
+    pose (where the runtime drives them), by path name."""
+    cell = tomllib.loads(cell_text)
+    board = next(f for f in cell["fixture"] if f["name"] == fixture)
+    a = math.radians(board.get("angle_deg", 0.0))
+    ox, oy = board["origin_mm"]
+    return {path["name"]: [(ox + math.cos(a) * x - math.sin(a) * y, oy + math.sin(a) * x + math.cos(a) * y)
+                           for x, y in path["points_mm"]] for path in board["scan_path"]}
+
+
+def trips_of_cycle(probes, paths, two_stage, path_points):
     """The trips the runtime latched, by index: its probe moves in order, per
     path until the first move that did not trip (smtcal_probe_trips.ngc).
     With two stages a trip is three probe moves (find the edge, back over
-    it, latch it), the last of them the trip."""
+    it, latch it), the last of them the trip.
+
+    Whether a move tripped: the driver reads motion's flag in the status
+    poll that shows the move's new result, and on a loaded host that poll
+    can come after the next move began and the flag fell back. The runtime
+    leaves a path at its first move that does not trip, so a move followed
+    by another probe move on the same path (the nearest path's points: the
+    markers are far apart) tripped whatever the flag read."""
+    def path_of(probe):
+        return min(path_points, key=lambda name: min(math.dist((probe["x"], probe["y"]), point)
+                                                     for point in path_points[name]))
+
     trips = {}
     at = 0
     index = 0
@@ -384,7 +407,8 @@ def trips_of_cycle(probes, paths, two_stage):
         for k in range(count):
             moves = probes[at:at + (3 if two_stage else 1)]
             at += len(moves)
-            if not moves or not all(probe["tripped"] for probe in moves):
+            probed_on = at < len(probes) and path_of(probes[at]) == name
+            if not moves or not (all(probe["tripped"] for probe in moves) or probed_on):
                 break
             trips[index + k] = moves[-1]
         index += count
@@ -562,12 +586,13 @@ def run_machine(args, scenario, work):
     cell_text = open(cell).read()
     two_stage = re.search(r"(?m)^latch_speed_mm_s = ", cell_text) is not None
     scan_z = float(re.search(r"(?m)^scan_z_mm = (\S+)", cell_text).group(1))
+    path_points = scan_path_points(cell_text)
     measured = []
     previous = None
     verdicts = []
     check_cycles = []
     for n, cycle in enumerate(record["cycles"]):
-        trips = trips_of_cycle(cycle["probes"], paths, two_stage)
+        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
         scan_json = os.path.join(work, f"cycle{n + 1}-scan.json")
