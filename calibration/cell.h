@@ -74,6 +74,12 @@ struct Robot {
   // its leg (LinuxCNC's servo thread: 1 ms).
   double servo_period_s = 0.001;
   SourceRange servo_period_range;  // its key (the [robot] table when absent)
+  // What a probe move costs the controller besides the move itself: it
+  // plans the next move only once the probe's result is in (LinuxCNC 2.9
+  // without a realtime kernel, [TASK]CYCLE_TIME 0.001: 0.025 s measured,
+  // each task cycle about a third of it). Feeds the scan's time.
+  double probe_turnaround_s = 0.025;
+
   // The final approach: every calibrated target is reached by a last straight
   // x-y move of this vector, from target - approach to the target, so each
   // axis's backlash is taken up the same way at every target as at every
@@ -175,8 +181,17 @@ struct Fixture {
   std::array<MarkerEdge, 4> edges;
   std::vector<ScanPath> scan_paths;  // at least one; every edge crossed at least twice
   double scan_z_mm = 0;          // sensor height over the markers (robot z)
-  double scan_speed_mm_s = 0;    // feed along the scan paths
+  double scan_speed_mm_s = 0;    // feed along the scan paths (two stages: the search's)
   SourceRange scan_speed_range;  // its key
+  // Two-stage probing: each edge is found at scan_speed_mm_s, crossed back
+  // and latched again at this feed. 0 (the key absent): one stage, every trip
+  // latched at scan_speed_mm_s. Never above scan_speed_mm_s.
+  double latch_speed_mm_s = 0;
+  SourceRange latch_speed_range;  // its key (the [[fixture]] table when absent)
+  // The feed at which the controller latches a trip: latch_speed_mm_s with
+  // two stages, else scan_speed_mm_s. A trip lands up to this times the
+  // servo period past its edge.
+  double TripLatchSpeedMmS() const { return latch_speed_mm_s > 0 ? latch_speed_mm_s : scan_speed_mm_s; }
   double trip_window_mm = 0;     // a trip is expected within this distance of its nominal point along the leg
   int sensor_input = 0;          // digital input the sensor is wired to
   double sensor_accuracy_mm = 0; // +- where the sensor trips against the true edge

@@ -60,6 +60,9 @@ inline constexpr NumberRange kAccuracyMm = AboveZero(10, "mm");
 inline constexpr NumberRange kCorrelationMm = Closed(0.1, 1e4, "mm");
 // The controller's servo period (probe latch): up to a second.
 inline constexpr NumberRange kServoPeriodS = AboveZero(1, "s");
+// What a probe move costs the controller besides the move (robot
+// probe_turnaround_s): 0 (none) up to a second; LinuxCNC's is 0.025 s.
+inline constexpr NumberRange kProbeTurnaroundS = Closed(0, 1, "s");
 // Motion for the cycle-time estimate: up to 100 m/s and 10 000 m/s² (1000 g).
 inline constexpr NumberRange kSpeedMmS = AboveZero(1e5, "mm/s");
 inline constexpr NumberRange kAccelerationMmS2 = AboveZero(1e7, "mm/s²");

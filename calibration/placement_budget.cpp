@@ -154,13 +154,14 @@ FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture
                                      std::vector<Eigen::Vector2d> region_table_se)
     : cell_(cell),
       sensor_accuracy_mm_(fixture.sensor_accuracy_mm),
-      latency_mm_(fixture.scan_speed_mm_s * cell.robot.servo_period_s),
+      latency_mm_(fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s),
       region_table_se_(region_table_se.empty() ? RegionTableNoise(cell) : std::move(region_table_se)) {
   trip_regions_ = TripRegions(fixture, cell.regions);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const Eigen::Affine3d nominal = NominalFix(fixture);
   const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, nominal);
   const Eigen::Matrix2d rotation = nominal.linear().topLeftCorner<2, 2>();
+  nominal_x_axis_ = rotation.col(0);
   const double h = kTripSensitivityStepMm;
   for (std::size_t k = 0; k < trips.size(); ++k) {
     const Eigen::Vector2d normal = EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]).normal;
@@ -243,6 +244,23 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
     }
   }
   return budget;
+}
+
+Eigen::Matrix3d FixtureErrorModel::PoseCovariance() const {
+  const cell::Robot& robot = cell_.robot;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < d_linear_.size(); ++k) {
+    // How the pose moves with trip k moving across its edge: its origin, and
+    // its angle (n turns by the part of dn across n).
+    const Eigen::Vector2d dn = d_linear_[k].col(0);
+    const Eigen::Vector3d j(d_origin_[k].x(), d_origin_[k].y(),
+                            nominal_x_axis_.x() * dn.y() - nominal_x_axis_.y() * dn.x());
+    const double late = latency_mm_ * leg_across_[k];
+    const double variance = UniformVariance(sensor_accuracy_mm_) + UniformVariance(robot.repeatability_mm) +
+                            UniformVariance(0.5 * late) + trip_table_se_[k] * trip_table_se_[k];
+    covariance += variance * j * j.transpose();
+  }
+  return covariance;
 }
 
 double OutsideProbability(const Eigen::Vector2d& mean_mm, const Eigen::Matrix2d& covariance_mm2,

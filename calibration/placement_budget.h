@@ -133,10 +133,16 @@ class FixtureErrorModel {
   // `region` (may be null) with that residual.
   ErrorBudget At(const Eigen::Vector2d& point_in_fixture, const cell::Region* region, double residual_mm) const;
 
+  // The covariance of the scanned pose (origin x, y in mm; angle in rad)
+  // from the random part of every trip's error: the sensor, the robot's
+  // repeatability, the latch latency's spread and the calibrating tables'
+  // noise (the latency's mean and the bounds are not in it). Requires defined().
+  Eigen::Matrix3d PoseCovariance() const;
+
  private:
   const cell::Cell& cell_;
   double sensor_accuracy_mm_ = 0;
-  double latency_mm_ = 0;  // scan_speed_mm_s * servo_period_s: how late a trip can be, along its leg
+  double latency_mm_ = 0;  // the latch feed * servo_period_s: how late a trip can be, along its leg
   bool defined_ = false;
   std::vector<int> trip_regions_;
   // Per trip: d(linear part)/de and d(translation)/de, e across the edge.
@@ -148,6 +154,7 @@ class FixtureErrorModel {
   // |n_x| E_x + |n_y| E_y); 0 if none.
   std::vector<double> trip_interpolation_mm_;
   std::vector<Eigen::Vector2d> region_table_se_;  // RegionTableNoise of the cell
+  Eigen::Vector2d nominal_x_axis_ = Eigen::Vector2d::UnitX();  // n of the nominal FIX
 };
 
 // The probability that a placement with error mean `mean_mm` and a normal

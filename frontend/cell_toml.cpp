@@ -29,6 +29,7 @@
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
 #include "calibration/placement_budget.h"
+#include "calibration/scan_plan.h"
 #include "calibration/tolerances.h"
 #include "calibration/truth_spec.h"
 #include "frontend/input_kind.h"
@@ -518,6 +519,9 @@ void Loader::ReadRobot(const toml::table& table, Robot& robot) {
       robot.final_approach_mm = a;
     }
   }
+  if (auto turnaround = NumberIn(keys, "probe_turnaround_s", limits::kProbeTurnaroundS, Need::kOptional)) {
+    robot.probe_turnaround_s = *turnaround;
+  }
   keys.Finish();
   robot_ = robot;
   robot_ok_ = diags_.error_count() == errors_before;
@@ -969,6 +973,17 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   }
   ReadPocket(keys, fixture);
   fixture.scan_speed_mm_s = NumberIn(keys, "scan_speed_mm_s", limits::kSpeedMmS).value_or(0);
+  fixture.latch_speed_range = keys.KeyRange("latch_speed_mm_s");
+  if (std::optional<Located<double>> latch = Number(keys, "latch_speed_mm_s", Need::kOptional, limits::kSpeedMmS)) {
+    if (fixture.scan_speed_mm_s > 0 && latch->value > fixture.scan_speed_mm_s) {
+      diags_.Report(DiagKind::CellValueOutOfRange, latch->range, "'latch_speed_mm_s'", Num(latch->value),
+                    fmt::format("at most scan_speed_mm_s = {} mm/s: the search finds each edge at the scan "
+                                "speed, the latch measures it again slower",
+                                Num(fixture.scan_speed_mm_s)));
+    } else {
+      fixture.latch_speed_mm_s = latch->value;
+    }
+  }
   std::optional<double> window = NumberIn(keys, "trip_window_mm", limits::kTripWindowMm);
   fixture.trip_window_mm = window.value_or(0);
   fixture.sensor_input =
@@ -1336,11 +1351,21 @@ static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostic
                   fmt::format("{:.3f}", windows[k].nominal.x()), fmt::format("{:.3f}", windows[k].nominal.y()),
                   Num(fixture.trip_window_mm), accuracy);
   }
-  const double late_mm = fixture.scan_speed_mm_s * cell.robot.servo_period_s;
+  const double late_mm = fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s;
   if (late_mm > 0.25 * fixture.max_line_residual_mm) {
-    diags.Report(DiagKind::CellTripLatency, fixture.scan_speed_range, Printable(fixture.name),
-                  Num(fixture.scan_speed_mm_s), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
-                  Num(fixture.max_line_residual_mm));
+    const bool two_stage = fixture.latch_speed_mm_s > 0;
+    diags.Report(DiagKind::CellTripLatency, two_stage ? fixture.latch_speed_range : fixture.scan_speed_range,
+                  Printable(fixture.name), two_stage ? "latches its trips" : "scans",
+                  Num(fixture.TripLatchSpeedMmS()), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
+                  Num(fixture.max_line_residual_mm), two_stage ? "latch_speed_mm_s" : "scan_speed_mm_s");
+  }
+  const CaptureRange capture = ScanCaptureRange(fixture);
+  if (capture.factor < 1) {
+    const ScanPath& first = fixture.scan_paths.front();
+    diags.Report(DiagKind::CellScanCaptureRange, first.range, Printable(fixture.name),
+                  fmt::format("{:.2f}", capture.shift_mm), fmt::format("{:.2f}", capture.rotation_deg),
+                  fmt::format("{:.2f}", capture.factor), capture.limited_by, Num(fixture.max_shift_mm),
+                  Num(fixture.max_rotation_deg));
   }
 }
 

@@ -4,6 +4,8 @@
 // frontend/linuxcnc_output.h for `smtcal diff`.
 #pragma once
 
+#include <string_view>
+
 namespace smtcal {
 
 // The parameter layout shared with runtime/linuxcnc/*.ngc (README.md there).
@@ -20,6 +22,9 @@ inline constexpr int kSafeZ = 36;             // the robot's safe_limz_mm
 inline constexpr int kReportOnly = 37;        // 1: a failed check is recorded, not aborted (tests)
 inline constexpr int kDataStart = 40;         // directories, records, tables from here
 inline constexpr int kLayoutVersion = 1;
+// The named parameter smtcal_data.ngc sets to the runtime's identity (the
+// main program checks it before its first move; not part of the cell).
+inline constexpr std::string_view kRuntimeIdParameter = "#<_smtcal_runtime_id>";
 
 // Fixture record offsets.
 inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 3, kFxSin = 4, kFxL1 = 5,
@@ -29,7 +34,7 @@ inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 
                      kFxTripNominalAt = 29, kFxTripsAt = 30, kFxTrippedAt = 31, kFxCalibratedAt = 32,
                      kFxScanPathsAt = 33, kFxHasFix = 34, kFxFix = 35, kFxStatus = 41, kFxFailedTrip = 42,
                      kFxCheckValue = 43 /* + code 1..11 */, kFxCheckEvaluated = 55 /* + code */, kFxS = 67,
-                     kFxScale = 73, kFxRecordSize = 80;
+                     kFxScale = 73, kFxLatchFeed = 74, kFxRecordSize = 80;
 // Region record offsets.
 inline constexpr int kRgXLo = 0, kRgXHi = 1, kRgYLo = 2, kRgYHi = 3, kRgDomain = 4, kRgContraction = 8,
                      kRgIterationBound = 9, kRgOutside = 10, kRgDxAt = 11, kRgDyAt = 12, kRgRecordSize = 13;

@@ -117,6 +117,7 @@ class DataReader {
         continue;
       }
       if (!in_sub || !line.starts_with('#')) return ReadError{number, "a line that is not a parameter of o<smtcal_data>"};
+      if (line.starts_with(L::kRuntimeIdParameter)) continue;  // the runtime's identity, not the cell's data
       // #N = value[  ; what]
       const std::size_t eq = line.find(" = ");
       if (eq == std::string_view::npos) return ReadError{number, "a parameter line without ' = '"};
@@ -239,6 +240,7 @@ class DataReader {
     fixture.max_line_residual_mm = Value(at + L::kFxMaxLineResidual);
     fixture.scan_z_mm = Value(at + L::kFxScanZ);
     fixture.scan_speed_mm_s = Value(at + L::kFxScanFeed) / 60;
+    fixture.latch_speed_mm_s = Value(at + L::kFxLatchFeed) / 60;  // 0: one stage
     const int trips = Integer(at + L::kFxTripCount);
     if (trips < 1 || trips > 64) Fail(at + L::kFxTripCount, "a trip count out of range");
     if (!error_.what.empty()) return;
@@ -548,8 +550,18 @@ class Decompiler {
     }
     const std::uint32_t header_line = header.number;
     while (Peek().comment_only) Next();
-    Expect("G21 G90 G17 G94");
+    Expect("G21 G90 G17 G94 G61");
     Expect("o<smtcal_data> call");
+    // The check that the runtime on the path is the one compiled with the
+    // program: two ifs, each aborting (not part of the program's text).
+    for (const char* condition : {"EXISTS[#<_smtcal_runtime_id>] EQ 0]", "#<_smtcal_runtime_id> NE "}) {
+      const NgcLine& check = Next();
+      if (!check.block.starts_with('o') || check.block.find(std::string(" if [") + condition) == std::string::npos) {
+        Fail(check, "the main program without its runtime check");
+      }
+      if (!Next().comment.starts_with("abort,")) Fail(lines_[at_ - 1], "a runtime check without its abort");
+      if (!Next().block.ends_with(" endif")) Fail(lines_[at_ - 1], "a runtime check without its endif");
+    }
     // Points, then globals.
     std::vector<std::pair<std::string, std::uint32_t>> points;  // .place line, .ngc line
     while (true) {

@@ -466,7 +466,7 @@ class Simulator {
   std::vector<std::optional<Eigen::Vector2d>> Scan(const cell::Fixture& fixture, const Eigen::Affine3d& board) {
     const Eigen::Affine3d nominal = NominalFix(fixture);
     const double accuracy = truth_.noise ? truth_.sensor_accuracy_mm.value_or(fixture.sensor_accuracy_mm) : 0.0;
-    const double latency_mm = fixture.scan_speed_mm_s * servo_period_s_;
+    const double latency_mm = fixture.TripLatchSpeedMmS() * servo_period_s_;
     const std::vector<ExpectedTrip>& expected = ExpectedFor(fixture);
     std::vector<std::optional<Eigen::Vector2d>> trips;
     for (const ExpectedTrip& e : expected) {

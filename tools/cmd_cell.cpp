@@ -10,8 +10,10 @@
 
 #include "backend/reports/table_report.h"
 #include "backend/reports/cell_plot.h"
+#include "base/field_text.h"
 #include "base/json_text.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/scan_plan.h"
 #include "frontend/cell_toml.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
@@ -78,6 +80,15 @@ std::string SummaryText(const cell::Cell& cell) {
                        fixture.name, Num(fixture.origin_mm.x()), Num(fixture.origin_mm.y()), Num(fixture.angle_deg),
                        Num(fixture.l1_mm), Num(fixture.l2_mm), fixture.scan_paths.size(),
                        ExpectedTrips(fixture).size(), cell::EstimatorName(fixture.estimator), teach);
+    const CaptureRange capture = ScanCaptureRange(fixture);
+    out += fmt::format("    scan: {}; capture range {} mm and {} deg, {} x the limits ({} mm, {} deg){}\n",
+                       fixture.latch_speed_mm_s > 0
+                           ? fmt::format("two stages, search {} mm/s, latch {} mm/s", Num(fixture.scan_speed_mm_s),
+                                         Num(fixture.latch_speed_mm_s))
+                           : fmt::format("one stage at {} mm/s", Num(fixture.scan_speed_mm_s)),
+                       fmt::format("{:.2f}", capture.shift_mm), fmt::format("{:.3f}", capture.rotation_deg),
+                       fmt::format("{:.2f}", capture.factor), Num(fixture.max_shift_mm), Num(fixture.max_rotation_deg),
+                       capture.factor >= 1 ? "" : ": smaller than the limits");
   }
 
   out += fmt::format("feeders: {}\n", cell.feeders.size());
@@ -104,6 +115,16 @@ std::string SummaryText(const cell::Cell& cell) {
 
 ordered_json Pair(double a, double b) { return ordered_json::array({a, b}); }
 ordered_json Pair(const cell::Interval& interval) { return Pair(interval.lo, interval.hi); }
+
+ordered_json CaptureJson(const CaptureRange& capture, const cell::Fixture& fixture) {
+  return {{"factor", RoundedToDecimals(capture.factor, 4)},
+          {"shift_mm", RoundedToDecimals(capture.shift_mm, 4)},
+          {"rotation_deg", RoundedToDecimals(capture.rotation_deg, 5)},
+          {"covers_limits", capture.factor >= 1},
+          {"limited_by", capture.limited_by.empty() ? ordered_json() : ordered_json(capture.limited_by)},
+          {"max_shift_mm", fixture.max_shift_mm},
+          {"max_rotation_deg", fixture.max_rotation_deg}};
+}
 
 std::string SummaryJson(const cell::Cell& cell) {
   ordered_json out;
@@ -155,7 +176,10 @@ std::string SummaryJson(const cell::Cell& cell) {
          {"trips", ExpectedTrips(fixture).size()},
          {"estimator", cell::EstimatorName(fixture.estimator)},
          {"teach_scan", !fixture.teach_trips_mm.empty()},
-         {"teach_trips", fixture.teach_trips_mm.size()}});
+         {"teach_trips", fixture.teach_trips_mm.size()},
+         {"scan_speed_mm_s", fixture.scan_speed_mm_s},
+         {"latch_speed_mm_s", fixture.latch_speed_mm_s > 0 ? ordered_json(fixture.latch_speed_mm_s) : ordered_json()},
+         {"capture", CaptureJson(ScanCaptureRange(fixture), fixture)}});
   }
   out["feeders"] = ordered_json::array();
   for (const cell::Feeder& feeder : cell.feeders) {

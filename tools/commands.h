@@ -110,5 +110,6 @@ bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path,
                      Diagnostics& diags, GlobalOptions& options, std::optional<cell::Cell>& cell,
                      std::optional<measure::LoadedPlan>& plan);
 void AddSetupSheetCommand(CLI::App& app, GlobalOptions& options);
+void AddScanCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

@@ -219,6 +219,7 @@ int main(int argc, char** argv) {
   AddCellCommand(app, options);
   AddDiffCommand(app, options);
   AddSimulateCommand(app, options);
+  AddScanCommand(app, options);
   AddMeasureCommand(app, options);
   AddSetupSheetCommand(app, options);
   int exit_code = Prescan(argc, argv);

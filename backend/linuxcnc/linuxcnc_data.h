@@ -25,6 +25,12 @@ std::optional<std::string> LinuxCncDataProblem(const cell::Cell& cell);
 // checked).
 std::string EmitLinuxCncData(const cell::Cell& cell);
 
+// What identifies the runtime of a compile: smtcal's version, its runtime
+// files, the cell's data and abort messages (FNV-1a, 31 bits: an integer
+// rs274 holds exactly). smtcal_data.ngc sets #<_smtcal_runtime_id> to it;
+// the main program refuses to run with another.
+long LinuxCncRuntimeId(const cell::Cell& cell);
+
 // A number as rs274 reads it back exactly: a plain decimal (no exponent) with
 // the fewest decimals that round-trip, correctly rounded; "0" for zero.
 std::string LinuxCncNumber(double value);

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "calibration/motion_time.h"
+#include "calibration/scan_plan.h"
 #include "ir/constant_fold.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
@@ -271,23 +272,32 @@ class VerifyTargets final : public Pass {
     return value ? value->value : robot.safe_limz_mm;
   }
 
-  // The marker scan: to each V path's start, then along it at the scan feed.
+  // The marker scan as the runtime drives it (calibration/scan_plan.h), from
+  // where the robot stands; it leaves the robot above the last path's end.
   static double ScanTime(const cell::Robot& robot, const FixtureBinding& binding, Position& at) {
-    const cell::Fixture& fixture = *binding.cell_fixture;
-    double seconds = 0;
-    for (const cell::ScanPath& path : fixture.scan_paths) {
-      std::vector<Pose4> points;
-      for (const cell::Point2& p : path.points) {
-        points.push_back(PoseToBase(binding.nominal, {p.x(), p.y(), fixture.scan_z_mm, 0}));
-      }
-      if (at.known) seconds += JumpTime(robot, at.pose, points.front(), robot.safe_limz_mm);
-      for (std::size_t i = 1; i < points.size(); ++i) {
-        double length = std::hypot(points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]);
-        seconds += fixture.scan_speed_mm_s > 0 ? length / fixture.scan_speed_mm_s : 0;
-      }
-      at = {points.back(), true};
+    std::optional<ScanPoint> from;
+    if (at.known) from = ScanPoint(at.pose[0], at.pose[1], at.pose[2]);
+    const ScanTiming timing = smtcal::ScanTime(robot, *binding.cell_fixture, from);
+    at = {{timing.end.x(), timing.end.y(), timing.end.z(), at.known ? at.pose[3] : 0.0}, true};
+    return timing.seconds;
+  }
+
+  // Where the robot is commanded for a target (base frame; a fixture
+  // target's at the fixture's nominal pose).
+  static const Pose4& Command(const Target& target) {
+    return target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+  }
+
+  // Where a cycle leaves the robot: its last known target. The cycle repeats,
+  // so the next one, and its scan, start there.
+  static Position CycleEnd(const CompileState& state, const std::vector<TraceEvent>& events) {
+    Position end;
+    for (const TraceEvent& event : events) {
+      if (event.kind != TraceEvent::Kind::kMotion) continue;
+      const Target& target = state.targets[event.target];
+      if (target.known) end = {Command(target), true};
     }
-    return seconds;
+    return end;
   }
 
   static void EstimateCycles(CompileState& state) {
@@ -298,7 +308,7 @@ class VerifyTargets final : public Pass {
       CycleEstimate estimate;
       estimate.cycle = stmt;
       estimate.fixture = cycle.fixture;
-      Position at;
+      Position at = CycleEnd(state, events);
       int fixture = state.FindFixture(cycle.fixture);
       if (fixture >= 0) estimate.scan_s = ScanTime(robot, state.fixtures[fixture], at);
       for (const TraceEvent& event : events) {
@@ -308,7 +318,7 @@ class VerifyTargets final : public Pass {
         }
         const Target& target = state.targets[event.target];
         if (!target.known) continue;
-        const Pose4& to = target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+        const Pose4& to = Command(target);
         bool jump = !std::holds_alternative<ir::Motion>(target.stmt->node) ||
                     std::get<ir::Motion>(target.stmt->node).kind == ir::MotionKind::Jump;
         if (at.known) {

@@ -23,7 +23,12 @@
 #            shows it: on = a Pick, off = a Place (M64/M65 wait until the
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
-#   messages every operator message (an abort is one).
+#   messages every operator message (an abort is one);
+#   trace    per cycle, the machine's position (x, y, z) at every status
+#            update that shows it changed, from the clamp to the cycle's
+#            first vacuum change: when the scan's first move began and
+#            when the first placement move left the scan (run_scenario.py
+#            measures the scan's overhead from it).
 # With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
 # every Place also records where the robot really was ("real": the model's
 # position latched in the servo thread when the valve went off).
@@ -48,8 +53,9 @@ def hal(commands):
 
 def place_board(pose, sensor_models):
     """The board's true pose for the sensor HAL (marker-sensor.hal): per
-    marker k, f = R(a)^T (M p + b - o) into sum2.(2k) and sum2.(2k+1), where
-    M p + b is where the robot really puts the sensor for a command p."""
+    marker k (the models in marker order), f = R(a)^T (M p + b - o) into
+    sum2.(2k) and sum2.(2k+1), where M p + b is where the robot really puts
+    the sensor for a command p around that marker."""
     a = math.radians(pose["angle_deg"])
     c, s = math.cos(a), math.sin(a)
     o = (pose["x_mm"], pose["y_mm"])
@@ -148,6 +154,10 @@ def main():
         drain_messages()
         # A probe move's result: motion's latched position changes (the
         # tripped flag alone falls back when the next move starts).
+        if cycle is not None and "traced" not in cycle:
+            here = [round(v, 6) for v in stat.position[:3]]
+            if not cycle["trace"] or cycle["trace"][-1][1:] != here:
+                cycle["trace"].append([now()] + here)
         probe = tuple(stat.probed_position[:3])
         if probe != last_probe:
             last_probe = probe
@@ -166,6 +176,8 @@ def main():
                     # off (latched in the servo thread by run_measure.py's model).
                     event["real"] = [reader["x"], reader["y"]]
                 record["vacuum"].append(event)
+                if cycle is not None:
+                    cycle["traced"] = True  # the trace ends at the cycle's first Pick
             elif stat.dout[out] and clamped:
                 # The program released the board: this cycle is done.
                 hal(["sets transport-clamped false"])
@@ -185,7 +197,9 @@ def main():
             place_board(pose, plan["sensor_models"])
             hal(["sets transport-clamped true"])
             clamped = True
-            cycle = {"pose": pose, "clamped_s": now(), "probes": []}
+            stat.poll()
+            cycle = {"pose": pose, "clamped_s": now(), "probes": [],
+                     "trace": [[now()] + [round(v, 6) for v in stat.position[:3]]]}
             record["cycles"].append(cycle)
             next_cycle += 1
         time.sleep(0.001)

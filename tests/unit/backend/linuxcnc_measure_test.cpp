@@ -18,11 +18,13 @@
 #include <fstream>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "backend/linuxcnc/embedded_files.h"
 #include "tests/unit/backend/rs274_runner.h"
 #include "tests/unit/test_support.h"
 
@@ -223,3 +225,17 @@ TEST(LinuxCncMeasure, CompiledPlacementsEndWithTheFinalApproach) {
 
 }  // namespace
 }  // namespace smtcal
+
+// The example machine's SUBROUTINE_PATH holds the placing runtime's folder
+// and the measuring runtime's (examples/linuxcnc/paper-cell.ini): LinuxCNC
+// takes the first file of a name on the path, so a name both runtimes used
+// would silently run the wrong one in one of them.
+TEST(LinuxCncMeasureFiles, ShareNoNameWithThePlacingRuntime) {
+  std::set<std::string> placing;
+  for (const smtcal::EmbeddedFile& file : smtcal::LinuxCncRuntimeFiles()) placing.insert(file.name);
+  placing.insert("smtcal_data.ngc");  // written beside the runtime by compile
+  ASSERT_FALSE(smtcal::LinuxCncMeasureFiles().empty());
+  for (const smtcal::EmbeddedFile& file : smtcal::LinuxCncMeasureFiles()) {
+    EXPECT_EQ(placing.count(file.name), 0u) << file.name << " is in both runtimes";
+  }
+}
