@@ -27,9 +27,9 @@ const KindInfo& Info(DiagKind kind) { return kKinds[static_cast<std::size_t>(kin
 
 std::string Location(const SourceManager& sources, const SourceRange& range) {
   if (range.begin.file == 0) return "smtcal";
-  const SourceFile& file = sources.File(range.begin.file);
-  if (range.begin.line == 0) return file.name;
-  return fmt::format("{}:{}:{}", file.name, range.begin.line, range.begin.column);
+  const std::string name = Printable(sources.File(range.begin.file).name);
+  if (range.begin.line == 0) return name;
+  return fmt::format("{}:{}:{}", name, range.begin.line, range.begin.column);
 }
 
 // A source line longer than this many bytes is quoted as a window around
@@ -38,14 +38,14 @@ std::string Location(const SourceManager& sources, const SourceRange& range) {
 constexpr std::size_t kSnippetMaxBytes = 320;
 constexpr std::size_t kSnippetBytesBeforeCaret = 120;
 constexpr std::string_view kEllipsis = "...";
-constexpr std::size_t kMaxMessageBytes = 1000;
 
 bool IsContinuationByte(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
 
 // The quoted source line and a caret line under the range. The line is made
-// safe for a terminal (control characters and invalid UTF-8 bytes become
-// '?'), and the caret line advances one column per character, not per byte,
-// so the caret sits under the right character in UTF-8 text. Tabs are kept.
+// safe for a terminal (Printable's kSourceLine: control characters and
+// invalid UTF-8 bytes become '?'), and the caret line advances one column per
+// character, not per byte, so the caret sits under the right character in
+// UTF-8 text. Tabs are kept.
 void AppendSnippet(std::string& out, const SourceManager& sources, const SourceRange& range) {
   if (!range.begin.known()) return;
   std::string_view line = sources.File(range.begin.file).Line(range.begin.line);
@@ -62,15 +62,12 @@ void AppendSnippet(std::string& out, const SourceManager& sources, const SourceR
     while (to < line.size() && IsContinuationByte(line[to])) ++to;
   }
   std::string shown(from > 0 ? kEllipsis : "");
+  shown += Printable(line.substr(from, to - from), TextQuoting::kSourceLine);
   std::string marks(from > 0 ? kEllipsis.size() : 0, ' ');
   bool caret_placed = false;
-  for (std::size_t i = from; i < to;) {
-    std::size_t length = Utf8Length(line, i);
-    unsigned char c = static_cast<unsigned char>(line[i]);
-    bool printable = length > 1 || (length == 1 && (c >= 0x20 || c == '\t') && c != 0x7F);
-    std::size_t step = length == 0 ? 1 : length;
-    shown += printable ? std::string(line.substr(i, step)) : std::string("?");
-    char mark = c == '\t' ? '\t' : ' ';
+  for (std::size_t i = from; i < to;) {  // one mark per character Printable shows
+    std::size_t step = std::max<std::size_t>(Utf8Length(line, i), 1);
+    char mark = line[i] == '\t' ? '\t' : ' ';
     if (i + step > begin && i < end) mark = caret_placed ? '~' : '^';
     if (mark == '^') caret_placed = true;
     marks += mark;
@@ -105,6 +102,17 @@ std::vector<const Diagnostic*> InSourceOrder(const std::vector<Diagnostic>& diag
 
 }  // namespace
 
+// A message quotes fields of the input: whatever a reader forgot to quote
+// becomes valid UTF-8 here (docs/files-and-exit-codes.md), and a 2 MB column
+// name must not make a 2 MB message.
+std::string Diagnostics::Printed(std::string_view message) {
+  return CutForMessage(Printable(message, TextQuoting::kMessage));
+}
+
+void Diagnostics::AddNote(Diagnostic* diag, SourceRange range, std::string_view text) {
+  if (diag != nullptr) diag->notes.emplace_back(range, Printed(text));
+}
+
 std::string_view DiagKindName(DiagKind kind) { return Info(kind).name; }
 Severity DiagKindSeverity(DiagKind kind) { return Info(kind).severity; }
 std::string_view DiagKindFormat(DiagKind kind) { return Info(kind).format; }
@@ -120,14 +128,7 @@ std::string_view SeverityName(Severity severity) {
 
 Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
   if (limit_reached_) return nullptr;
-  // A message quotes fields of the input; a 2 MB column name must not make
-  // a 2 MB message. Cut at a character boundary.
-  if (message.size() > kMaxMessageBytes) {
-    std::size_t cut = kMaxMessageBytes;
-    while (cut > 0 && IsContinuationByte(message[cut])) --cut;
-    message.resize(cut);
-    message += kEllipsis;
-  }
+  message = Printed(message);
   Severity severity = DiagKindSeverity(kind);
   if (severity == Severity::Error && error_count_ >= error_limit_) {
     limit_reached_ = true;

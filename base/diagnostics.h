@@ -58,9 +58,9 @@ class Diagnostics {
   }
   // Attaches a note to the diagnostic returned by Report (ignored if null:
   // Report returns null once the error or warning limit is reached).
-  static void AddNote(Diagnostic* diag, SourceRange range, std::string text) {
-    if (diag != nullptr) diag->notes.emplace_back(range, std::move(text));
-  }
+  // Messages and notes are made valid UTF-8 and cut after kMaxMessageBytes
+  // (base/field_text.h), whatever they quote.
+  static void AddNote(Diagnostic* diag, SourceRange range, std::string_view text);
 
   // Takes back every diagnostic of `kind` (a command that reports the same
   // finding its own way, e.g. simulate measuring what verify's budget
@@ -84,6 +84,7 @@ class Diagnostics {
 
  private:
   Diagnostic* Add(DiagKind kind, SourceRange range, std::string message);
+  static std::string Printed(std::string_view message);
 
   const SourceManager& sources_;
   std::size_t error_limit_;

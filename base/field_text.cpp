@@ -11,27 +11,46 @@
 namespace smtcal {
 
 std::size_t Utf8Length(std::string_view text, std::size_t i) {
+  // Well-formed UTF-8 (RFC 3629, Unicode's table 3-7): no overlong forms, no
+  // surrogates (U+D800..U+DFFF), nothing beyond U+10FFFF. The second byte's
+  // range depends on the first; later bytes are any continuation byte.
   auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
   const unsigned char lead = byte(i);
-  std::size_t length = lead < 0x80           ? 1
-                       : (lead >> 5) == 0x6   ? 2
-                       : (lead >> 4) == 0xe   ? 3
-                       : (lead >> 3) == 0x1e  ? 4
-                                              : 0;
-  if (length == 0 || i + length > text.size()) return 0;
-  for (std::size_t k = 1; k < length; ++k) {
+  if (lead < 0x80) return 1;
+  std::size_t length = 0;
+  unsigned char second_lo = 0x80, second_hi = 0xBF;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    if (lead == 0xE0) second_lo = 0xA0;  // overlong below U+0800
+    if (lead == 0xED) second_hi = 0x9F;  // surrogates
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    if (lead == 0xF0) second_lo = 0x90;  // overlong below U+10000
+    if (lead == 0xF4) second_hi = 0x8F;  // beyond U+10FFFF
+  } else {
+    return 0;  // a continuation byte, C0/C1 (overlong ASCII), F5..FF
+  }
+  if (i + length > text.size()) return 0;
+  if (byte(i + 1) < second_lo || byte(i + 1) > second_hi) return 0;
+  for (std::size_t k = 2; k < length; ++k) {
     if ((byte(i + k) & 0xc0) != 0x80) return 0;
   }
   return length;
 }
 
-std::string Printable(std::string_view text) {
+std::string Printable(std::string_view text, TextQuoting quoting) {
   std::string out;
+  out.reserve(text.size());
   for (std::size_t i = 0; i < text.size();) {
     auto byte = static_cast<unsigned char>(text[i]);
     std::size_t length = Utf8Length(text, i);
-    if (length == 0 || byte < 0x20 || byte == 0x7f) {
-      out += fmt::format("\\x{:02x}", byte);
+    const bool control = length == 1 && (byte < 0x20 || byte == 0x7f);
+    const bool kept_control = (byte == '\t' && quoting != TextQuoting::kField) ||
+                              (byte == '\n' && quoting == TextQuoting::kMessage);
+    if (length == 0 || (control && !kept_control)) {
+      out += quoting == TextQuoting::kSourceLine ? std::string("?") : fmt::format("\\x{:02x}", byte);
       ++i;
     } else {
       out += text.substr(i, length);
@@ -39,6 +58,14 @@ std::string Printable(std::string_view text) {
     }
   }
   return out;
+}
+
+std::string CutForMessage(std::string text) {
+  if (text.size() <= kMaxMessageBytes) return text;
+  std::size_t cut = kMaxMessageBytes;
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+  text.resize(cut);
+  return text + "...";
 }
 
 std::optional<double> ParseNumber(std::string_view text) {

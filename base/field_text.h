@@ -11,13 +11,33 @@
 
 namespace smtcal {
 
-// The length of the valid UTF-8 sequence at text[i], or 0 if there is none.
+// The length of the well-formed UTF-8 sequence at text[i] (1 to 4 bytes), or
+// 0 if there is none: a stray continuation byte, an overlong form, a
+// surrogate, a code point beyond U+10FFFF, or a sequence cut short.
 std::size_t Utf8Length(std::string_view text, std::size_t i);
 
-// A field's text for a message: control characters and bytes that are not
-// UTF-8 shown as \xNN, so a binary file cannot garble the terminal, cut a
-// message short, or make the JSON output invalid.
-std::string Printable(std::string_view text);
+// How Printable shows what a terminal or a JSON reader must not get.
+enum class TextQuoting {
+  // A name or field quoted in a message: control characters and bytes that
+  // are not UTF-8 as \xNN, so a binary file cannot garble the
+  // terminal or cut a message short.
+  kField,
+  // A whole message or note: as kField, but tabs and line breaks are kept.
+  kMessage,
+  // The source line under a diagnostic: one '?' for each such byte (tabs
+  // kept), so the caret line stays aligned, character for character.
+  kSourceLine,
+};
+
+// The one quoting function for text from the user's files and command line
+// that smtcal writes on stderr (docs/files-and-exit-codes.md): the result is
+// always valid UTF-8.
+std::string Printable(std::string_view text, TextQuoting quoting = TextQuoting::kField);
+
+// The most bytes of a message or note that quotes the input; longer ones are
+// cut (at a character boundary) and end in "...".
+inline constexpr std::size_t kMaxMessageBytes = 1000;
+std::string CutForMessage(std::string text);
 
 // A decimal number written exactly as `text` (optional sign, digits, '.',
 // exponent), read locale-independently with fast_float. nullopt when it is

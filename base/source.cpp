@@ -169,25 +169,6 @@ std::string TemporaryPrefix(const std::string& file_name) {
   return file_name.substr(0, keep) + std::string(kTemporaryMark);
 }
 
-// Removes temporaries of `file_name` left by smtcal processes that no longer
-// run (killed while writing). A temporary of a running process is its own.
-void RemoveStaleTemporaries(const std::string& directory, const std::string& file_name) {
-  const std::string prefix = TemporaryPrefix(file_name);
-  DIR* dir = ::opendir(directory.c_str());
-  if (dir == nullptr) return;
-  while (const dirent* entry = ::readdir(dir)) {
-    std::string_view name = entry->d_name;
-    if (!name.starts_with(prefix) || name.size() == prefix.size()) continue;
-    std::string_view digits = name.substr(prefix.size());
-    long pid = 0;
-    auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
-    if (ec != std::errc() || end != digits.data() + digits.size() || pid <= 0) continue;
-    if (pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
-    ::unlink((directory + "/" + std::string(name)).c_str());
-  }
-  ::closedir(dir);
-}
-
 
 }  // namespace
 
@@ -200,7 +181,7 @@ Result<StagedOutput> StagedOutput::Open(const std::string& path) {
   staged.destination_ = std::move(destination).value();
   const std::string directory = DirectoryOf(staged.destination_);
   const std::string file_name = FileNameOf(staged.destination_);
-  RemoveStaleTemporaries(directory, file_name);
+  RemoveStaleTemporaries(directory, TemporaryPrefix(file_name), [](const std::string& stale) { ::unlink(stale.c_str()); });
 
   mode_t mode = 0666;  // less the umask, as any new file
   struct stat existing {};
@@ -271,6 +252,30 @@ StagedOutput::~StagedOutput() {
   if (!temporary_.empty()) ::unlink(temporary_.c_str());
 }
 
+std::string OutputDestination(const std::string& path) {
+  Result<std::string> destination = Destination(path);
+  return destination ? destination.value() : path;
+}
+
+void RemoveStaleTemporaries(const std::string& directory, const std::string& prefix,
+                            void (*remove)(const std::string& path)) {
+  DIR* dir = ::opendir(directory.c_str());
+  if (dir == nullptr) return;
+  std::vector<std::string> stale;
+  while (const dirent* entry = ::readdir(dir)) {
+    std::string_view name = entry->d_name;
+    if (!name.starts_with(prefix) || name.size() == prefix.size()) continue;
+    std::string_view digits = name.substr(prefix.size());
+    long pid = 0;
+    auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+    if (ec != std::errc() || end != digits.data() + digits.size() || pid <= 0) continue;
+    if (pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    stale.push_back(directory + "/" + std::string(name));
+  }
+  ::closedir(dir);
+  for (const std::string& path : stale) remove(path);
+}
+
 Status WriteToStdout(std::string_view text) {
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
@@ -297,6 +302,19 @@ Status WriteFileAtomically(const std::string& path, std::string_view contents) {
   Result<StagedOutput> staged = StagedOutput::Stage(path, contents);
   if (!staged) return staged.error();
   return staged.value().Commit();
+}
+
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<StagedOutput> staged;
+  for (const auto& [path, contents] : outputs) {
+    Result<StagedOutput> stage = StagedOutput::Stage(path, contents);
+    if (!stage) return stage.error();
+    staged.push_back(std::move(stage).value());
+  }
+  for (StagedOutput& output : staged) {
+    if (Status committed = output.Commit(); !committed) return committed;
+  }
+  return Ok{};
 }
 
 }  // namespace smtcal

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "base/result.h"
@@ -93,11 +94,26 @@ class StagedOutput {
   int write_error_ = 0;      // the errno of the first failed write
 };
 
+// The file a write of `path` replaces: symbolic links followed, as
+// StagedOutput follows them (`path` itself when it cannot be resolved; the
+// write will say why). For commands that check their outputs against each
+// other before writing.
+std::string OutputDestination(const std::string& path);
+
+// Removes the temporaries "<prefix><pid>" in `directory` of smtcal processes
+// that no longer run (killed while writing); a temporary of a running process
+// is its own. `remove` removes one (a file, or a folder output's folder).
+void RemoveStaleTemporaries(const std::string& directory, const std::string& prefix,
+                            void (*remove)(const std::string& path));
+
 // `text` on standard output, flushed: the "-" output of StagedOutput and
 // TextOutput.
 Status WriteToStdout(std::string_view text);
 
 // Stage and Commit in one: a failure never leaves a half-written output.
 Status WriteFileAtomically(const std::string& path, std::string_view contents);
+// Several outputs (path, contents), all or none: every one is staged before
+// any is committed.
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 }  // namespace smtcal

@@ -26,6 +26,7 @@
 
 #include "base/source.h"
 #include "calibration/error_table.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 
 namespace smtcal::cell {
@@ -73,8 +74,30 @@ struct Robot {
   // its leg (LinuxCNC's servo thread: 1 ms).
   double servo_period_s = 0.001;
   SourceRange servo_period_range;  // its key (the [robot] table when absent)
+  // What a probe move costs the controller besides the move itself: it
+  // plans the next move only once the probe's result is in (LinuxCNC 2.9
+  // without a realtime kernel, [TASK]CYCLE_TIME 0.001: 0.025 s measured,
+  // each task cycle about a third of it). Feeds the scan's time.
+  double probe_turnaround_s = 0.025;
+
+  // The final approach: every calibrated target is reached by a last straight
+  // x-y move of this vector, from target - approach to the target, so each
+  // axis's backlash is taken up the same way at every target as at every
+  // node of the measurement (docs/measure.md, "Backlash"). Unset: targets are
+  // reached straight, and `smtcal measure plan` asks for it.
+  std::optional<Eigen::Vector2d> final_approach_mm;
+  SourceRange final_approach_range;  // its key (the [robot] table when absent)
   SourceRange range;        // the [robot] table
 };
+
+// What the robot declares about the roughness of its error
+// (uncalibrated_accuracy_mm over uncalibrated_correlation_mm); nullopt when
+// it declares no accuracy.
+std::optional<DeclaredRoughness> DeclaredRoughnessOf(const Robot& robot);
+// The interpolation error of a region's table in this robot's cell: with the
+// robot's declared roughness, and a node that states no noise counted as one
+// measurement with the robot's repeatability (as the budget does).
+InterpolationEstimate RegionInterpolation(const Robot& robot, const ErrorTable& table);
 
 // The axes a region's difficulty measure names.
 enum class TaskAxis { X, Y, Z, U };
@@ -98,8 +121,17 @@ struct Region {
   SourceRange difficulty_range;
   std::string table_path;  // as written, relative to the cell file
   SourceRange table_range;
-  ErrorTable table;        // loaded and validated (ValidateErrorTable passed)
+  // Loaded and validated (ValidateErrorTable passed). Only a cell loaded for
+  // planning a measurement (CellLoadOptions) may have a region without a
+  // table yet: then has_table is false, the table and domain are empty, and
+  // the bounds are as written.
+  bool has_table = true;
+  std::uint32_t table_file = 0;  // the table file's SourceManager id (0: not read from a file)
+  ErrorTable table;
   Rect domain;             // TableDomain(table): where F is defined
+  // How far the robot's error may depart from the table's interpolation
+  // between its nodes: RegionInterpolation(robot, table), set by the loader.
+  InterpolationEstimate interpolation;
   double tolerance_mm = 0;  // the task tolerance: +- this around the required position
   SourceRange tolerance_range;
   OutsidePolicy outside = OutsidePolicy::kError;  // policy for points outside the grid
@@ -149,8 +181,17 @@ struct Fixture {
   std::array<MarkerEdge, 4> edges;
   std::vector<ScanPath> scan_paths;  // at least one; every edge crossed at least twice
   double scan_z_mm = 0;          // sensor height over the markers (robot z)
-  double scan_speed_mm_s = 0;    // feed along the scan paths
+  double scan_speed_mm_s = 0;    // feed along the scan paths (two stages: the search's)
   SourceRange scan_speed_range;  // its key
+  // Two-stage probing: each edge is found at scan_speed_mm_s, crossed back
+  // and latched again at this feed. 0 (the key absent): one stage, every trip
+  // latched at scan_speed_mm_s. Never above scan_speed_mm_s.
+  double latch_speed_mm_s = 0;
+  SourceRange latch_speed_range;  // its key (the [[fixture]] table when absent)
+  // The feed at which the controller latches a trip: latch_speed_mm_s with
+  // two stages, else scan_speed_mm_s. A trip lands up to this times the
+  // servo period past its edge.
+  double TripLatchSpeedMmS() const { return latch_speed_mm_s > 0 ? latch_speed_mm_s : scan_speed_mm_s; }
   double trip_window_mm = 0;     // a trip is expected within this distance of its nominal point along the leg
   int sensor_input = 0;          // digital input the sensor is wired to
   double sensor_accuracy_mm = 0; // +- where the sensor trips against the true edge
@@ -174,6 +215,13 @@ struct Fixture {
   // import asks for --place-z instead of guessing.
   std::optional<double> place_z_mm;
   SourceRange place_z_range;  // the place_z_mm key
+  // The pocket boards sit in (pocket_x_mm, pocket_y_mm: x and y intervals in
+  // the fixture frame): `smtcal import` puts a board's outline, turned over
+  // for its bottom side, into the pocket's lower left corner, so the top and
+  // the bottom of one board are placed where the board really lies. Absent:
+  // import centres the board on a calibrated region instead.
+  std::optional<std::array<Interval, 2>> pocket_mm;
+  SourceRange pocket_range;  // the pocket_x_mm key
   SourceRange range;  // the [[fixture]] table
 };
 
@@ -205,13 +253,24 @@ struct Feeder {
   FeederKind kind = FeederKind::kTape;
   SourceRange kind_range;  // the kind key (the [[feeder]] table when absent)
   SourceRange range;  // the [[feeder]] table
+
+  int pick_points() const { return columns * rows; }  // 1 without a pallet
+  // Pick point k (1-based, PalletPickPoint's order).
+  std::array<double, 4> PickPoint(int k) const;
 };
 
-// The cycle record's bound per file ([linuxcnc] record_max_cycles): a week
-// of the paper cell's cycles; at most what `smtcal monitor` reads in one
-// file (256 MiB) for a fixture of 32 trips.
+// The cycle record's bound per file ([linuxcnc] record_max_cycles, its
+// range limits::kRecordMaxCycles): a week of the paper cell's cycles.
 inline constexpr int kDefaultRecordMaxCycles = 10000;
-inline constexpr int kMaxRecordMaxCycles = 100000;
+// Pick point k (1 .. columns * rows) of a pallet, in the order of the
+// language's Pallet(n, k): along the first row from `first` to `last`, then
+// row after row toward `back` (the first column of the last row; `first`
+// when absent). Without `last` (one pick point) it is `first`. The cell's
+// feeders, the feeders file's and the picture of the cell all use it.
+std::array<double, 4> PalletPickPoint(const std::array<double, 4>& first,
+                                      const std::optional<std::array<double, 4>>& last,
+                                      const std::optional<std::array<double, 4>>& back, int columns, int rows,
+                                      int k);
 
 // [linuxcnc]: how the cell's LinuxCNC controller is wired, for
 // `smtcal compile --target linuxcnc` (docs/linuxcnc.md). Optional: only that
@@ -231,9 +290,91 @@ struct LinuxCnc {
   SourceRange range;             // the [linuxcnc] table
 };
 
+// [measure]: the instrument that measures the robot's error at the nodes of
+// a region (docs/measure.md, docs/cell.md). One of three devices:
+enum class MeasureDevice {
+  // The paper's (Fig. 4): a linear displacement transducer touches the flank
+  // of a groove in a precise plate the robot carries; the flank turns the
+  // robot's error along the axis into a vertical displacement, read as an
+  // analog input, and a second transducer on the plate's surface takes out
+  // the robot's z error. One axis per run (the transducer is mounted for it).
+  kTransducer,
+  // A touch probe in the gripper against a precise hole at every node (a
+  // hole plate): the probe moves from the node towards the hole's wall along
+  // each axis; the trip against the wall's calibrated position is the error.
+  kProbe,
+  // An external system (camera, CMM, laser tracker): the program triggers it
+  // at every node and waits for it; its readings come as CSV keyed by node.
+  kExternal,
+};
+inline constexpr std::array<std::string_view, 3> kMeasureDeviceNames = {"transducer", "probe", "external"};
+
+struct MeasureTransducer {
+  int input = 0;            // motion.analog-in-NN of the measuring transducer (on the groove's flank)
+  int reference_input = 1;  // motion.analog-in-NN of the z reference transducer (on the plate's surface)
+  // The reading's change per mm of the robot's error along the measured axis
+  // (the flank's slope, signed: 1 for a 45 degree flank rising with the axis).
+  double slope = 1;
+  // The measuring minus the reference reading with the robot exactly at the
+  // node (from the set-up: the plate's certificate and the zeroing gauge).
+  double zero_mm = 0;
+  Interval range_mm{0, 1};  // readings outside it: the transducer lost contact (the program aborts)
+  double groove_pitch_mm = 5;  // nodes and check points must lie on grooves: multiples of it from the first node
+  int grooves = 11;            // grooves per direction: the plate's reach
+};
+
+struct MeasureProbe {
+  double hole_diameter_mm = 0;    // the holes' calibrated diameter
+  double hole_pitch_mm = 5;       // the holes sit on a square lattice of this pitch; nodes and check points must be holes
+  double stylus_diameter_mm = 0;  // the stylus ball's effective diameter (calibrated on a ring gauge)
+  double speed_mm_s = 1;          // the probing feed
+  double overtravel_mm = 0.5;     // how far past the expected wall a probe move may go before it is a miss
+};
+
+struct MeasureExternal {
+  int trigger_output = 0;  // motion.digital-out-NN: on asks the system for a reading
+  int done_input = 0;      // motion.digital-in-NN: on when the system has taken it
+  int node_output = 0;     // motion.analog-out-NN: the node; the set and repetition on the next two
+};
+
+struct Measure {
+  MeasureDevice device = MeasureDevice::kProbe;
+  SourceRange device_range;
+  double z_mm = 0;        // the robot z at which the device reads
+  double clear_z_mm = 0;  // the z between nodes (default: the robot's safe_limz_mm)
+  double dwell_s = 0.2;   // settle time at the node before the reading
+  double noise_mm = 0;    // one standard deviation of a single reading (the device's stated noise)
+  double timeout_s = 5;   // how long the program waits for the device before it aborts
+  double reading_time_s = 0;  // the device's own time per reading (an external system's exposure), for the plan's time
+  std::optional<int> ready_input;  // motion.digital-in-NN, on while the device is ready (checked before each reading)
+  MeasureTransducer transducer;
+  MeasureProbe probe;
+  MeasureExternal external;
+  SourceRange range;  // the [measure] table
+};
+
 // LinuxCNC's motion controller has at most 64 digital inputs and outputs
 // (motion.digital-in/out-00..63, [EMCMOT]num_dio).
 inline constexpr int kLinuxCncMaxDio = 64;
+// ... and at most 64 analog inputs and outputs (motion.analog-in/out-NN, [EMCMOT]num_aio).
+inline constexpr int kLinuxCncMaxAio = 64;
+
+// A file a cell was read from, with the SHA-256 of its bytes (base/sha256.h):
+// what a compiled program records of the cell it was compiled for, so
+// `smtcal diff` can tell whether a cell is that one (docs/diff.md).
+struct CellFile {
+  bool table = false;        // an error table (else the cell file itself)
+  std::string path;          // the cell file as given; a table as the cell file writes it
+  std::string sha256;        // 64 lowercase hex digits
+  std::vector<std::string> regions;  // a table: the regions that use it, in cell order
+};
+
+// How a compiled output records one of its cell's files, in a comment line
+// (docs/diff.md): "cell file sha256 <64 hex digits> <path>" or "table file
+// sha256 <64 hex digits> <path>". The regions are not part of it.
+std::string CellFileLine(const CellFile& file);
+// The inverse, for the text of such a comment; nullopt for anything else.
+std::optional<CellFile> ParseCellFileLine(std::string_view text);
 
 struct Cell {
   std::string name;    // the `name` key; default: the file name without .cell.toml / .toml
@@ -244,6 +385,11 @@ struct Cell {
   std::vector<Fixture> fixtures;
   std::vector<Feeder> feeders;
   std::optional<LinuxCnc> linuxcnc;  // the [linuxcnc] table, when the file has one
+  std::optional<Measure> measure;    // the [measure] table, when the file has one
+  // The cell file, then each table file once, in the order the regions name
+  // them: set by the loader (and by the reader of a LinuxCNC output, from
+  // what the compile wrote there).
+  std::vector<CellFile> files;
 
   const Fixture* FindFixture(std::string_view name) const;  // case-insensitive
   const Region* FindRegion(std::string_view name) const;    // case-insensitive

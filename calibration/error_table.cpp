@@ -14,11 +14,15 @@
 #include <fmt/format.h>
 
 #include "base/check.h"
+#include "calibration/limits.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
 
 std::string_view AxisName(TableAxis axis) { return axis == TableAxis::X ? "x" : "y"; }
+
+std::string_view ReadingKindName(ReadingKind kind) { return kind == ReadingKind::kNode ? "node" : "check"; }
 
 std::string FormatMm(double mm) {
   if (mm == 0) mm = 0;  // no "-0.000"
@@ -30,6 +34,8 @@ std::string FormatMm(double mm) {
   }
   return fmt::format("{}", mm);
 }
+
+std::string FormatComputedMm(double mm) { return FormatMm(std::round(mm * 1e6) / 1e6); }
 
 SourceRange AxisTable::Origin(std::size_t i, std::size_t j) const {
   return origin.empty() ? SourceRange() : origin[Index(i, j)];
@@ -92,8 +98,20 @@ std::optional<AxisTable> AxisAssembly::Run() {
     return static_cast<std::size_t>(it - lines.begin());
   };
 
-  // Which grid nodes have a row (first row wins; later ones are duplicates).
+  // A table's lines are crossed into nx x ny nodes, each with a row: far
+  // fewer rows than that is not a grid with holes but no grid at all (rows
+  // on a diagonal make n^2 nodes of n rows). Said once, before the nodes are
+  // laid out, so the work stays in proportion to the rows (calibration/limits.h).
   const std::size_t nx = xs.size(), ny = ys.size();
+  const double nodes_needed = static_cast<double>(nx) * static_cast<double>(ny);
+  const double rows_given = static_cast<double>(members.size());
+  if (nodes_needed - rows_given > static_cast<double>(limits::kMaxMissingNodesListed)) {
+    diags.Report(DiagKind::TableGridIncomplete, nodes[members.front()].x_field, name, nx, ny,
+                 fmt::format("{:.0f}", nodes_needed), members.size(), fmt::format("{:.0f}", nodes_needed - rows_given));
+    return std::nullopt;
+  }
+
+  // Which grid nodes have a row (first row wins; later ones are duplicates).
   std::vector<std::optional<std::size_t>> at(nx * ny);
   std::vector<std::size_t> strays;
   for (std::size_t k : members) {
@@ -217,6 +235,45 @@ std::optional<AxisTable> AxisAssembly::Run() {
   return table;
 }
 
+// The check points of an assembled axis table: inside its grid's rectangle,
+// away from the nodes, one per position; sorted by y, then x.
+bool AddCheckPoints(AxisTable& table, TableAxis axis, const std::vector<TableNode>& nodes,
+                    const std::vector<std::size_t>& checks, Diagnostics& diags) {
+  const std::string_view name = AxisName(axis);
+  const std::size_t errors_before = diags.error_count();
+  std::map<std::pair<double, double>, std::size_t> seen;  // (y, x) -> index into nodes
+  for (std::size_t k : checks) {
+    const TableNode& check = nodes[k];
+    const double x0 = table.xs.front(), x1 = table.xs.back(), y0 = table.ys.front(), y1 = table.ys.back();
+    if (check.x_mm < x0 || check.x_mm > x1 || check.y_mm < y0 || check.y_mm > y1) {
+      diags.Report(DiagKind::TableCheckOutsideGrid, check.x_field, FormatMm(check.x_mm), FormatMm(check.y_mm), name,
+                   FormatMm(x0), FormatMm(x1), FormatMm(y0), FormatMm(y1));
+      continue;
+    }
+    const CellPlace place = PlaceInCell(table, check.x_mm, check.y_mm);
+    if (place.CentreShare() < kMinCheckPointShare) {
+      const std::size_t i = place.i + (place.s > 0.5 ? 1 : 0), j = place.j + (place.t > 0.5 ? 1 : 0);
+      const bool on = table.xs[i] == check.x_mm && table.ys[j] == check.y_mm;
+      diags.Report(DiagKind::TableCheckNearNode, check.x_field, FormatMm(check.x_mm), FormatMm(check.y_mm), name,
+                   on ? "on" : "too near", FormatMm(table.xs[i]), FormatMm(table.ys[j]),
+                   fmt::format("{:.0f}", 100 * place.CentreShare()), fmt::format("{:.0f}", 100 * kMinCheckPointShare),
+                   FormatMm(0.5 * (table.xs[place.i] + table.xs[place.i + 1])),
+                   FormatMm(0.5 * (table.ys[place.j] + table.ys[place.j + 1])));
+      continue;
+    }
+    auto [it, inserted] = seen.emplace(std::make_pair(check.y_mm, check.x_mm), k);
+    if (!inserted) {
+      const TableNode& first = nodes[it->second];
+      Diagnostic* diag = diags.Report(DiagKind::TableDuplicateCheck, check.x_field, FormatMm(check.x_mm),
+                                      FormatMm(check.y_mm), name, LineOf(first.x_field));
+      Diagnostics::AddNote(diag, first.x_field, "first given here");
+    }
+  }
+  if (diags.error_count() != errors_before) return false;
+  for (const auto& [position, k] : seen) table.checks.push_back(nodes[k]);
+  return true;
+}
+
 }  // namespace
 
 std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector<TableNode>& nodes,
@@ -226,8 +283,10 @@ std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector
   bool ok = true;
   for (TableAxis axis : kTableAxes) {
     AxisAssembly assembly{axis, nodes, {}, diags};
+    std::vector<std::size_t> checks;
     for (std::size_t k = 0; k < nodes.size(); ++k) {
-      if (nodes[k].axis == axis) assembly.members.push_back(k);
+      if (nodes[k].axis != axis) continue;
+      (nodes[k].kind == ReadingKind::kNode ? assembly.members : checks).push_back(k);
     }
     if (assembly.members.empty()) {
       diags.Report(DiagKind::TableMissingAxis, SourceRange(SourceLoc{file.file, 0, 0}), AxisName(axis));
@@ -235,7 +294,7 @@ std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector
       continue;
     }
     std::optional<AxisTable> axis_table = assembly.Run();
-    if (!axis_table) {
+    if (!axis_table || !AddCheckPoints(*axis_table, axis, nodes, checks, diags)) {
       ok = false;
       continue;
     }

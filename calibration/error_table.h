@@ -30,10 +30,23 @@ std::string_view AxisName(TableAxis axis);  // "x" or "y"
 // A length for messages and written tables: 3 decimals when that reads back
 // exactly (150.004), else 6 when that does, else the shortest round-trip form.
 std::string FormatMm(double mm);
+// A computed position for messages: rounded to 1 nm first, so the noise of
+// arithmetic (138 + 234.21 = 372.21000000000004) does not show.
+std::string FormatComputedMm(double mm);
 
-// One node as read from a file or averaged from raw measurements, with where
-// it came from so every diagnostic can point at its row.
+// What a row of a table or raw measurement file is (its optional `kind`
+// column): a reading at a grid node (the default), or a check point, a
+// reading off the grid nodes (e.g. at a cell centre) that the table keeps as
+// evidence of how well the interpolation between the nodes holds
+// (calibration/interpolation_error.h).
+enum class ReadingKind { kNode, kCheck };
+std::string_view ReadingKindName(ReadingKind kind);  // "node" or "check"
+
+// One node (or check point) as read from a file or averaged from raw
+// measurements, with where it came from so every diagnostic can point at its
+// row.
 struct TableNode {
+  ReadingKind kind = ReadingKind::kNode;
   TableAxis axis = TableAxis::X;
   double x_mm = 0;
   double y_mm = 0;
@@ -53,6 +66,10 @@ struct AxisTable {
   std::vector<std::optional<double>> stddev_mm;  // empty, or one per node
   std::vector<int> count;                        // empty, or one per node (0 = not given)
   std::vector<SourceRange> origin;               // empty, or one per node: its value's field
+  // Check points of this axis (kind = check): readings off the grid nodes,
+  // each inside the grid's rectangle and away from the nodes
+  // (kMinCheckPointShare), sorted by y, then x.
+  std::vector<TableNode> checks;
 
   std::size_t nx() const { return xs.size(); }
   std::size_t ny() const { return ys.size(); }
@@ -77,7 +94,10 @@ struct ErrorTable {
 // and pointing at its row): an axis without rows, a coordinate off the grid
 // (a line used by a single row: a typo), grid lines closer than
 // kMinGridLineSpacingMm, duplicate nodes, missing nodes, a grid smaller than
-// 2 x 2, grids that do not overlap. nullopt when anything was reported.
+// 2 x 2, grids that do not overlap; and of the check points (kind = check):
+// one outside its axis's grid rectangle, one on or too near a grid node
+// (kMinCheckPointShare), two at the same position. nullopt when anything was
+// reported.
 // `file` locates the diagnostics that concern the whole file.
 std::optional<ErrorTable> AssembleErrorTable(std::string name, const std::vector<TableNode>& nodes,
                                              SourceLoc file, Diagnostics& diags);

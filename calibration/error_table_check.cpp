@@ -123,72 +123,32 @@ void ReportSteep(const ErrorTable& table, const TableAnalysis& analysis, Diagnos
   AddMoreCellsNote(diag, suspect, failing - 1, "is too steep", "are too steep");
 }
 
-void WarnSignChanges(const ErrorTable& table, Diagnostics& diags) {
-  for (TableAxis axis : kTableAxes) {
-    const AxisTable& t = table[axis];
-    std::size_t pairs = 0;
-    std::size_t fi = 0, fj = 0, si = 0, sj = 0;
-    // A node's value is "clearly of its sign" when it is farther from zero
-    // than kSignChangeMinMm and three of its standard errors: smaller values
-    // are noise around zero, where the paper's condition says nothing.
-    auto clear = [&](std::size_t i, std::size_t j) {
-      const double se = t.StandardErrorMm(t.Index(i, j)).value_or(0.0);
-      return std::abs(t.At(i, j)) > std::max(kSignChangeMinMm, 3 * se);
-    };
-    auto visit = [&](std::size_t i, std::size_t j, std::size_t i2, std::size_t j2) {
-      if (!(t.At(i, j) * t.At(i2, j2) < 0) || !clear(i, j) || !clear(i2, j2)) return;
-      if (pairs++ == 0) {
-        fi = i, fj = j, si = i2, sj = j2;
-      }
-    };
-    for (std::size_t j = 0; j < t.ny(); ++j) {
-      for (std::size_t i = 0; i < t.nx(); ++i) {
-        if (i + 1 < t.nx()) visit(i, j, i + 1, j);
-        if (j + 1 < t.ny()) visit(i, j, i, j + 1);
-      }
-    }
-    if (pairs == 0) continue;
+void WarnSignChanges(const ErrorTable& table, const std::vector<SignChangeFinding>& findings, Diagnostics& diags) {
+  for (const SignChangeFinding& f : findings) {
+    const AxisTable& t = table[f.axis];
     Diagnostic* diag = diags.Report(
-        DiagKind::TableSignChange, t.Origin(fi, fj), AxisName(axis),
-        fmt::format("{} {}", pairs, pairs == 1 ? "pair" : "pairs"), Signed(t.At(fi, fj)),
-        FormatMm(t.xs[fi]), FormatMm(t.ys[fj]), Signed(t.At(si, sj)), FormatMm(t.xs[si]),
-        FormatMm(t.ys[sj]));
-    Diagnostics::AddNote(diag, t.Origin(si, sj), "the neighbouring node");
+        DiagKind::TableSignChange, t.Origin(f.i, f.j), AxisName(f.axis),
+        fmt::format("{} {}", f.pairs, f.pairs == 1 ? "pair" : "pairs"), Signed(t.At(f.i, f.j)), FormatMm(t.xs[f.i]),
+        FormatMm(t.ys[f.j]), Signed(t.At(f.i2, f.j2)), FormatMm(t.xs[f.i2]), FormatMm(t.ys[f.j2]));
+    Diagnostics::AddNote(diag, t.Origin(f.i2, f.j2), "the neighbouring node");
   }
 }
 
-void WarnOverHalfPitch(const ErrorTable& table, Diagnostics& diags) {
-  for (TableAxis axis : kTableAxes) {
-    const AxisTable& t = table[axis];
-    std::size_t count = 0, wi = 0, wj = 0;
-    double worst_ratio = 0, worst_pitch = 0;
-    for (std::size_t j = 0; j < t.ny(); ++j) {
-      for (std::size_t i = 0; i < t.nx(); ++i) {
-        double pitch = std::numeric_limits<double>::infinity();
-        if (i > 0) pitch = std::min(pitch, t.xs[i] - t.xs[i - 1]);
-        if (i + 1 < t.nx()) pitch = std::min(pitch, t.xs[i + 1] - t.xs[i]);
-        if (j > 0) pitch = std::min(pitch, t.ys[j] - t.ys[j - 1]);
-        if (j + 1 < t.ny()) pitch = std::min(pitch, t.ys[j + 1] - t.ys[j]);
-        double ratio = std::abs(t.At(i, j)) / pitch;
-        if (ratio <= kMaxErrorPitchFraction) continue;
-        ++count;
-        if (ratio > worst_ratio) {
-          worst_ratio = ratio, worst_pitch = pitch, wi = i, wj = j;
-        }
-      }
-    }
-    if (count == 0) continue;
-    std::string more = count > 1 ? fmt::format(" (and {} more {} of this table)", count - 1,
-                                               count == 2 ? "node" : "nodes")
-                                 : "";
-    diags.Report(DiagKind::TableErrorOverHalfPitch, t.Origin(wi, wj), AxisName(axis),
-                 Signed(t.At(wi, wj)), FormatMm(t.xs[wi]), FormatMm(t.ys[wj]), FormatMm(worst_pitch),
-                 more);
+std::string MoreNodes(std::size_t count) {
+  return count > 1 ? fmt::format(" (and {} more {} of this table)", count - 1, count == 2 ? "node" : "nodes") : "";
+}
+
+void WarnOverHalfPitch(const ErrorTable& table, const std::vector<OverHalfPitchFinding>& findings,
+                       Diagnostics& diags) {
+  for (const OverHalfPitchFinding& f : findings) {
+    const AxisTable& t = table[f.axis];
+    diags.Report(DiagKind::TableErrorOverHalfPitch, t.Origin(f.i, f.j), AxisName(f.axis), Signed(t.At(f.i, f.j)),
+                 FormatMm(t.xs[f.i]), FormatMm(t.ys[f.j]), FormatMm(f.pitch_mm), MoreNodes(f.count));
   }
 }
 
-void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
-  for (const TableOutlier& outlier : FindTableOutliers(table)) {
+void ReportOutliers(const ErrorTable& table, const std::vector<TableOutlier>& outliers, Diagnostics& diags) {
+  for (const TableOutlier& outlier : outliers) {
     const AxisTable& t = table[outlier.axis];
     diags.Report(DiagKind::TableOutlierNode, t.Origin(outlier.i, outlier.j), AxisName(outlier.axis),
                  Signed(outlier.value_mm), FormatMm(t.xs[outlier.i]), FormatMm(t.ys[outlier.j]),
@@ -198,6 +158,75 @@ void ReportOutliers(const ErrorTable& table, Diagnostics& diags) {
 }
 
 }  // namespace
+
+TableWarningFindings FindTableWarnings(const ErrorTable& table, const std::vector<TableOutlier>& outliers) {
+  TableWarningFindings findings;
+  for (TableAxis axis : kTableAxes) {
+    const AxisTable& t = table[axis];
+    // A node reported as an outlier is left out: its slip is reported once,
+    // as what it is, and never again as a sign change or a large error.
+    std::vector<bool> skip(t.error_mm.size(), false);
+    for (const TableOutlier& o : outliers) {
+      if (o.axis == axis) skip[t.Index(o.i, o.j)] = true;
+    }
+    // A node's value is "clearly of its sign" when it is farther from zero
+    // than kSignChangeMinMm and three of its standard errors: smaller values
+    // are noise around zero, where the paper's condition says nothing.
+    auto clear = [&](std::size_t i, std::size_t j) {
+      const double se = t.StandardErrorMm(t.Index(i, j)).value_or(0.0);
+      return std::abs(t.At(i, j)) > std::max(kSignChangeMinMm, 3 * se);
+    };
+    SignChangeFinding sign{axis};
+    auto visit = [&](std::size_t i, std::size_t j, std::size_t i2, std::size_t j2) {
+      if (skip[t.Index(i, j)] || skip[t.Index(i2, j2)]) return;
+      if (!(t.At(i, j) * t.At(i2, j2) < 0) || !clear(i, j) || !clear(i2, j2)) return;
+      if (sign.pairs++ == 0) sign.i = i, sign.j = j, sign.i2 = i2, sign.j2 = j2;
+    };
+    for (std::size_t j = 0; j < t.ny(); ++j) {
+      for (std::size_t i = 0; i < t.nx(); ++i) {
+        if (i + 1 < t.nx()) visit(i, j, i + 1, j);
+        if (j + 1 < t.ny()) visit(i, j, i, j + 1);
+      }
+    }
+    if (sign.pairs > 0) findings.sign_changes.push_back(sign);
+
+    OverHalfPitchFinding over{axis};
+    double worst_ratio = 0;
+    for (std::size_t j = 0; j < t.ny(); ++j) {
+      for (std::size_t i = 0; i < t.nx(); ++i) {
+        if (skip[t.Index(i, j)]) continue;
+        double pitch = std::numeric_limits<double>::infinity();
+        if (i > 0) pitch = std::min(pitch, t.xs[i] - t.xs[i - 1]);
+        if (i + 1 < t.nx()) pitch = std::min(pitch, t.xs[i + 1] - t.xs[i]);
+        if (j > 0) pitch = std::min(pitch, t.ys[j] - t.ys[j - 1]);
+        if (j + 1 < t.ny()) pitch = std::min(pitch, t.ys[j + 1] - t.ys[j]);
+        double ratio = std::abs(t.At(i, j)) / pitch;
+        if (ratio <= kMaxErrorPitchFraction) continue;
+        ++over.count;
+        if (ratio > worst_ratio) worst_ratio = ratio, over.pitch_mm = pitch, over.i = i, over.j = j;
+      }
+    }
+    if (over.count > 0) findings.over_half_pitch.push_back(over);
+  }
+  return findings;
+}
+
+std::vector<std::string> SummarizeTableWarnings(const ErrorTable& table) {
+  const TableWarningFindings findings = FindTableWarnings(table);
+  std::vector<std::string> lines;
+  for (const SignChangeFinding& f : findings.sign_changes) {
+    const AxisTable& t = table[f.axis];
+    lines.push_back(fmt::format("Δ{} changes sign between {} {} of neighbouring nodes (first at ({}, {}))",
+                                AxisName(f.axis), f.pairs, f.pairs == 1 ? "pair" : "pairs", FormatMm(t.xs[f.i]),
+                                FormatMm(t.ys[f.j])));
+  }
+  for (const OverHalfPitchFinding& f : findings.over_half_pitch) {
+    const AxisTable& t = table[f.axis];
+    lines.push_back(fmt::format("Δ{} = {} mm at ({}, {}) is more than half the grid pitch{}", AxisName(f.axis),
+                                Signed(t.At(f.i, f.j)), FormatMm(t.xs[f.i]), FormatMm(t.ys[f.j]), MoreNodes(f.count)));
+  }
+  return lines;
+}
 
 TableAnalysis AnalyzeTable(const ErrorTable& table) {
   SMTCAL_CHECK(HasUsableShape(table), "AnalyzeTable of a table that is not usable");
@@ -255,15 +284,23 @@ TableAnalysis AnalyzeTable(const ErrorTable& table) {
 
 bool ValidateErrorTable(const ErrorTable& table, Diagnostics& diags, TableWarnings warnings,
                         TableAnalysis* analysis_out) {
-  TableAnalysis analysis = AnalyzeTable(table);
   std::size_t errors_before = diags.error_count();
-  ReportOutliers(table, diags);
-  ReportFolds(table, analysis, diags);
+  const std::vector<TableOutlier> outliers = FindTableOutliers(table);
+  ReportOutliers(table, outliers, diags);
+  // The fold and slope checks look at the table with its outliers repaired:
+  // a slipped node folds the map around it, and that is the slip, reported
+  // once above. A fold that remains is a problem of its own.
+  const ErrorTable repaired = outliers.empty() ? ErrorTable() : WithOutliersRepaired(table, outliers);
+  const ErrorTable& checked = outliers.empty() ? table : repaired;
+  TableAnalysis analysis = AnalyzeTable(checked);
+  const std::size_t before_folds = diags.error_count();
+  ReportFolds(checked, analysis, diags);
   // A folding table is also steep; its fold is the message that matters.
-  if (diags.error_count() == errors_before) ReportSteep(table, analysis, diags);
+  if (diags.error_count() == before_folds) ReportSteep(checked, analysis, diags);
   if (warnings == TableWarnings::kReport) {
-    WarnSignChanges(table, diags);
-    WarnOverHalfPitch(table, diags);
+    const TableWarningFindings findings = FindTableWarnings(table, outliers);
+    WarnSignChanges(table, findings.sign_changes, diags);
+    WarnOverHalfPitch(table, findings.over_half_pitch, diags);
   }
   bool ok = diags.error_count() == errors_before;
   if (analysis_out != nullptr) *analysis_out = std::move(analysis);

@@ -18,12 +18,14 @@
 
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "base/diagnostics.h"
 #include "calibration/error_table.h"
+#include "calibration/table_outliers.h"
 
 namespace smtcal {
 
@@ -50,6 +52,33 @@ struct TableAnalysis {
 TableAnalysis AnalyzeTable(const ErrorTable& table);
 
 enum class TableWarnings { kReport, kSkip };
+
+// What ValidateErrorTable warns about, found without reporting it: per axis,
+// the pairs of neighbouring nodes between which the error changes sign (both
+// clearly off zero: kSignChangeMinMm and three standard errors; the first
+// pair), and the nodes whose error exceeds kMaxErrorPitchFraction of the
+// pitch around them (the worst).
+struct SignChangeFinding {
+  TableAxis axis = TableAxis::X;
+  std::size_t pairs = 0;
+  std::size_t i = 0, j = 0, i2 = 0, j2 = 0;  // the first pair
+};
+struct OverHalfPitchFinding {
+  TableAxis axis = TableAxis::X;
+  std::size_t count = 0;
+  std::size_t i = 0, j = 0;  // the worst node
+  double pitch_mm = 0;       // the smallest pitch around it
+};
+struct TableWarningFindings {
+  std::vector<SignChangeFinding> sign_changes;      // one per axis that has any
+  std::vector<OverHalfPitchFinding> over_half_pitch;  // likewise
+};
+// Nodes in `outliers` (FindTableOutliers) are left out of both.
+TableWarningFindings FindTableWarnings(const ErrorTable& table, const std::vector<TableOutlier>& outliers = {});
+// The same in one line per finding, for the summary the deciding commands
+// (verify, compile, cell check) print once per table: "Δx changes sign
+// between 5 pairs of neighbouring nodes (first at (150.000, 60.000))".
+std::vector<std::string> SummarizeTableWarnings(const ErrorTable& table);
 
 // Errors: the map folds or nearly folds (det < kMinJacobianDet) or the error
 // is too steep for the inverse solver (L > kMaxErrorSlope); each names the

@@ -279,16 +279,24 @@ std::optional<FixEstimate> EstimateFix(const cell::Fixture& fixture, const std::
 
 namespace {
 
-// Through the first map whose domain holds the point; unchanged when none does.
-Eigen::Vector2d DirectCalibrateThrough(const std::vector<CalibrationMap>& maps, const Eigen::Vector2d& commanded,
+// Through the first map whose domain holds the point; unchanged when none
+// does. `map_of(r)` gives region r's map.
+template <typename MapOf>
+Eigen::Vector2d DirectCalibrateThrough(std::size_t regions, const MapOf& map_of, const Eigen::Vector2d& commanded,
                                        int* region) {
-  for (std::size_t r = 0; r < maps.size(); ++r) {
-    if (!maps[r].Inside(commanded)) continue;
+  for (std::size_t r = 0; r < regions; ++r) {
+    const CalibrationMap& map = map_of(r);
+    if (!map.Inside(commanded)) continue;
     if (region != nullptr) *region = static_cast<int>(r);
-    return DirectCalibrate(maps[r], commanded, OutsidePolicy::kClamp).point;
+    return DirectCalibrate(map, commanded, OutsidePolicy::kClamp).point;
   }
   if (region != nullptr) *region = -1;
   return commanded;
+}
+Eigen::Vector2d DirectCalibrateThrough(const std::vector<CalibrationMap>& maps, const Eigen::Vector2d& commanded,
+                                       int* region) {
+  return DirectCalibrateThrough(
+      maps.size(), [&](std::size_t r) -> const CalibrationMap& { return maps[r]; }, commanded, region);
 }
 
 std::vector<CalibrationMap> MapsOf(const std::vector<cell::Region>& regions) {
@@ -545,6 +553,11 @@ CorrectedPoint PointCorrector::Invert(const Eigen::Vector2d& required) const {
 
 CorrectedPoint PointCorrector::Correct(const Eigen::Affine3d& fix_n, const Eigen::Vector2d& fixpos0) const {
   return Invert(ToBase(fix_n, fixpos0));
+}
+
+Eigen::Vector2d PointCorrector::Forward(const Eigen::Vector2d& commanded, int* region) const {
+  return DirectCalibrateThrough(
+      solvers_.size(), [&](std::size_t r) -> const CalibrationMap& { return solvers_[r].map(); }, commanded, region);
 }
 
 }  // namespace smtcal

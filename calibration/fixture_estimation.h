@@ -174,6 +174,9 @@ class PointCorrector {
   CorrectedPoint Invert(const Eigen::Vector2d& required) const;
   // FIX_n . FIXPOS_0, then F^-1.
   CorrectedPoint Correct(const Eigen::Affine3d& fix_n, const Eigen::Vector2d& fixpos0) const;
+  // Direct calibration of a command, as DirectCalibrateInCell does, through
+  // the tables this corrector holds (no maps built per call).
+  Eigen::Vector2d Forward(const Eigen::Vector2d& commanded, int* region = nullptr) const;
 
  private:
   const std::vector<cell::Region>& regions_;

@@ -49,6 +49,7 @@ std::string_view ErrorSourceName(ErrorSource source) {
     case ErrorSource::kResidual: return "residual";
     case ErrorSource::kRepeatability: return "repeatability";
     case ErrorSource::kTable: return "table";
+    case ErrorSource::kInterpolation: return "interpolation";
     case ErrorSource::kSensor: return "sensor";
     case ErrorSource::kScanRepeatability: return "scan_repeatability";
     case ErrorSource::kLatency: return "latency";
@@ -63,6 +64,7 @@ std::string_view ErrorSourceDescription(ErrorSource source) {
     case ErrorSource::kResidual: return "the inverse's residual";
     case ErrorSource::kRepeatability: return "the robot's repeatability";
     case ErrorSource::kTable: return "the table's measurement noise";
+    case ErrorSource::kInterpolation: return "the interpolation error between the tables' nodes";
     case ErrorSource::kSensor: return "the marker sensor's accuracy through the estimator";
     case ErrorSource::kScanRepeatability: return "the robot's repeatability at the trips";
     case ErrorSource::kLatency: return "the trip latency (scan speed x servo period)";
@@ -127,6 +129,11 @@ ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, dou
     ErrorShare& table = budget[ErrorSource::kTable];
     table.covariance_mm2 = se.cwiseAbs2().asDiagonal();
     table.worst_mm = kBudgetSigmas * se.norm();
+    // Systematic: the same departure every time the robot goes there, so a
+    // bound (taken in its worst direction by the process figures), never a
+    // random part that could average out.
+    ErrorShare& interpolation = budget[ErrorSource::kInterpolation];
+    interpolation.bound_mm = interpolation.worst_mm = region->interpolation.NormMm();
   }
   return budget;
 }
@@ -147,13 +154,14 @@ FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture
                                      std::vector<Eigen::Vector2d> region_table_se)
     : cell_(cell),
       sensor_accuracy_mm_(fixture.sensor_accuracy_mm),
-      latency_mm_(fixture.scan_speed_mm_s * cell.robot.servo_period_s),
+      latency_mm_(fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s),
       region_table_se_(region_table_se.empty() ? RegionTableNoise(cell) : std::move(region_table_se)) {
   trip_regions_ = TripRegions(fixture, cell.regions);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const Eigen::Affine3d nominal = NominalFix(fixture);
   const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, nominal);
   const Eigen::Matrix2d rotation = nominal.linear().topLeftCorner<2, 2>();
+  nominal_x_axis_ = rotation.col(0);
   const double h = kTripSensitivityStepMm;
   for (std::size_t k = 0; k < trips.size(); ++k) {
     const Eigen::Vector2d normal = EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]).normal;
@@ -169,14 +177,15 @@ FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture
     d_linear_.push_back((a->fix.linear().topLeftCorner<2, 2>() - b->fix.linear().topLeftCorner<2, 2>()) / (2 * h));
     d_origin_.push_back((FixOrigin(a->fix) - FixOrigin(b->fix)) / (2 * h));
     leg_across_.push_back(expected[k].leg_direction.dot(normal));
-    double se = 0;
+    double se = 0, interpolation = 0;
     if (trip_regions_[k] >= 0) {
-      const Eigen::Vector2d axis_se =
-          TableStandardErrorMm(cell.regions[static_cast<std::size_t>(trip_regions_[k])].table,
-                               cell.robot.repeatability_mm);
+      const cell::Region& region = cell.regions[static_cast<std::size_t>(trip_regions_[k])];
+      const Eigen::Vector2d axis_se = TableStandardErrorMm(region.table, cell.robot.repeatability_mm);
       se = std::sqrt(across.cwiseAbs2().dot(axis_se.cwiseAbs2()));
+      interpolation = across.cwiseAbs().dot(region.interpolation.PerAxisMm());
     }
     trip_table_se_.push_back(se);
+    trip_interpolation_mm_.push_back(interpolation);
   }
   defined_ = true;
 }
@@ -204,6 +213,7 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
   ErrorShare& scan_repeat = budget[ErrorSource::kScanRepeatability];
   ErrorShare& latency = budget[ErrorSource::kLatency];
   ErrorShare& trip_tables = budget[ErrorSource::kTripTables];
+  ErrorShare& interpolation = budget[ErrorSource::kInterpolation];
   ErrorShare& uncalibrated = budget[ErrorSource::kUncalibratedTrips];
   for (std::size_t k = 0; k < d_linear_.size(); ++k) {
     const Eigen::Vector2d g = d_linear_[k] * point_in_fixture + d_origin_[k];
@@ -222,6 +232,10 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
     if (trip_regions_[k] >= 0) {
       trip_tables.covariance_mm2 += trip_table_se_[k] * trip_table_se_[k] * gg;
       trip_tables.worst_mm += kBudgetSigmas * trip_table_se_[k] * gain;
+      // Every trip's departure at its worst, all moving the point the same
+      // way: the departures are systematic and need not cancel.
+      interpolation.bound_mm += gain * trip_interpolation_mm_[k];
+      interpolation.worst_mm += gain * trip_interpolation_mm_[k];
     } else if (robot.uncalibrated_accuracy_mm) {
       uncalibrated.bound_mm += gain * *robot.uncalibrated_accuracy_mm;
       uncalibrated.worst_mm += gain * *robot.uncalibrated_accuracy_mm;
@@ -230,6 +244,23 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
     }
   }
   return budget;
+}
+
+Eigen::Matrix3d FixtureErrorModel::PoseCovariance() const {
+  const cell::Robot& robot = cell_.robot;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < d_linear_.size(); ++k) {
+    // How the pose moves with trip k moving across its edge: its origin, and
+    // its angle (n turns by the part of dn across n).
+    const Eigen::Vector2d dn = d_linear_[k].col(0);
+    const Eigen::Vector3d j(d_origin_[k].x(), d_origin_[k].y(),
+                            nominal_x_axis_.x() * dn.y() - nominal_x_axis_.y() * dn.x());
+    const double late = latency_mm_ * leg_across_[k];
+    const double variance = UniformVariance(sensor_accuracy_mm_) + UniformVariance(robot.repeatability_mm) +
+                            UniformVariance(0.5 * late) + trip_table_se_[k] * trip_table_se_[k];
+    covariance += variance * j * j.transpose();
+  }
+  return covariance;
 }
 
 double OutsideProbability(const Eigen::Vector2d& mean_mm, const Eigen::Matrix2d& covariance_mm2,

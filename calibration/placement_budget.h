@@ -8,7 +8,9 @@
 // independent sources. Each contributes
 //   - a known mean (the trip latency: a trip is always late, never early),
 //   - an unknown systematic part known only by a bound (the inverse's
-//     residual; the robot's error at a trip no table corrects),
+//     residual; the robot's error at a trip no table corrects; how far the
+//     robot's error departs from the tables' interpolation between their
+//     nodes, at the placement and at the trips),
 //   - a random part with a covariance (repeatability, the sensor, the
 //     tables' own measurement noise, the latency's spread).
 // Random parts come from bounded uniform draws (the cell's "±" figures) or
@@ -57,15 +59,16 @@ enum class ErrorSource : int {
   kResidual = 0,       // the inverse calibration's residual |F(n) - a|
   kRepeatability,      // the robot's repeatability at the placement
   kTable,              // the measurement noise of the target region's table
+  kInterpolation,      // the interpolation error between table nodes: the region's and the trips' tables
   kSensor,             // the marker sensor's accuracy, through the estimator
   kScanRepeatability,  // the robot's repeatability at the trips, through the estimator
   kLatency,            // the controller's probe latch: trips late along their legs
   kTripTables,         // the measurement noise of the tables that calibrate the trips
   kUncalibratedTrips,  // the robot's own error at trips no table calibrates
 };
-inline constexpr std::size_t kErrorSources = 8;
-// residual, repeatability, table, sensor, scan_repeatability, latency,
-// trip_tables, uncalibrated_trips
+inline constexpr std::size_t kErrorSources = 9;
+// residual, repeatability, table, interpolation, sensor, scan_repeatability,
+// latency, trip_tables, uncalibrated_trips
 std::string_view ErrorSourceName(ErrorSource source);
 // Words for messages: "the robot's repeatability", ...
 std::string_view ErrorSourceDescription(ErrorSource source);
@@ -92,8 +95,9 @@ struct ErrorBudget {
 Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatability_mm);
 
 // A placement corrected through a region's table with no fixture (a static
-// target): the residual, the repeatability, the table's noise. `region` may
-// be null (then only the repeatability).
+// target): the residual, the repeatability, the table's noise and its
+// interpolation error (region->interpolation, as a bound on the length of
+// the departure vector). `region` may be null (then only the repeatability).
 ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm);
 // The same with the region's TableStandardErrorMm given: a compile asks for
 // every target's budget, so the tables' noise is found once (RegionTableNoise).
@@ -129,10 +133,16 @@ class FixtureErrorModel {
   // `region` (may be null) with that residual.
   ErrorBudget At(const Eigen::Vector2d& point_in_fixture, const cell::Region* region, double residual_mm) const;
 
+  // The covariance of the scanned pose (origin x, y in mm; angle in rad)
+  // from the random part of every trip's error: the sensor, the robot's
+  // repeatability, the latch latency's spread and the calibrating tables'
+  // noise (the latency's mean and the bounds are not in it). Requires defined().
+  Eigen::Matrix3d PoseCovariance() const;
+
  private:
   const cell::Cell& cell_;
   double sensor_accuracy_mm_ = 0;
-  double latency_mm_ = 0;  // scan_speed_mm_s * servo_period_s: how late a trip can be, along its leg
+  double latency_mm_ = 0;  // the latch feed * servo_period_s: how late a trip can be, along its leg
   bool defined_ = false;
   std::vector<int> trip_regions_;
   // Per trip: d(linear part)/de and d(translation)/de, e across the edge.
@@ -140,7 +150,11 @@ class FixtureErrorModel {
   std::vector<Eigen::Vector2d> d_origin_;
   std::vector<double> leg_across_;    // |leg direction . edge normal|: the latency's share across the edge
   std::vector<double> trip_table_se_;  // the calibrating table's standard error across the edge; 0 if none
+  // The calibrating table's interpolation error across the edge (a bound:
+  // |n_x| E_x + |n_y| E_y); 0 if none.
+  std::vector<double> trip_interpolation_mm_;
   std::vector<Eigen::Vector2d> region_table_se_;  // RegionTableNoise of the cell
+  Eigen::Vector2d nominal_x_axis_ = Eigen::Vector2d::UnitX();  // n of the nominal FIX
 };
 
 // The probability that a placement with error mean `mean_mm` and a normal

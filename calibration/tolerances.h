@@ -4,6 +4,8 @@
 // is. Limits of the language and the controller live in limits.h instead.
 #pragma once
 
+#include <cstddef>
+
 namespace smtcal {
 
 // --- error tables and inverse calibration ------------------------------------
@@ -60,7 +62,10 @@ inline constexpr double kMaxErrorPitchFraction = 0.5;
 // `table build` flags a node whose repetition scatter (pooled stddev) is above
 // median + kNoisyNodeMadFactor * 1.4826 * MAD of its axis's nodes (a robust
 // 5-sigma) and at least kNoisyNodeFloorMm (the transducers' resolution) above
-// the median, so a table of perfectly repeatable nodes does not flag noise.
+// the median, so a table of perfectly repeatable nodes does not flag noise;
+// and above the chi-square bound (at the same 5 sigma) of its own number of
+// readings against its axis's pooled scatter, so a node of two readings one
+// device step apart is not flagged where most nodes show no scatter at all.
 inline constexpr double kNoisyNodeMadFactor = 5.0;
 inline constexpr double kNoisyNodeFloorMm = 0.001;
 // ... and a node whose set means differ by more than kSetShiftFactor standard
@@ -68,6 +73,17 @@ inline constexpr double kNoisyNodeFloorMm = 0.001;
 // kSetShiftFloorMm: the robot or the fixture moved between the sets.
 inline constexpr double kSetShiftFactor = 6.0;
 inline constexpr double kSetShiftFloorMm = 0.001;
+// Screening the readings before they are averaged (calibration/reading_screen.h):
+// a reading farther from its set's median than this many robust scatters
+// (and kOutlierFloorMm) is an outlier; a set needs this many readings to
+// have a centre of its own. With the paper's 2.5 µm repetition scatter the
+// limit is 25 µm: ten times the largest deviation 2420 normal readings give.
+inline constexpr double kReadingOutlierFactor = 10.0;
+inline constexpr std::size_t kScreenMinSetSize = 3;
+// Of two sets a decimal point apart, the one farther from what the
+// neighbouring nodes predict is the culprit when the other is at least this
+// many times nearer; otherwise the node cannot tell.
+inline constexpr double kSetSlipDecisiveRatio = 3.0;
 
 // --- the cell file -------------------------------------------------------------
 // (frontend/cell_toml.cpp; docs/cell.md)
@@ -76,6 +92,11 @@ inline constexpr double kSetShiftFloorMm = 0.001;
 // S3 = (0,L2) within this. Edges and L1/L2 come from one drawing of the board,
 // so any larger miss is a typo or a wrong L1/L2, not a measurement error.
 inline constexpr double kMarkerGeometryTolMm = 1e-6;
+
+// The robot's final approach (robot.final_approach_mm) takes up backlash,
+// which is micrometres to a tenth of a millimetre: a longer approach is a
+// typo (or a unit mistake), and costs time at every target.
+inline constexpr double kMaxFinalApproachMm = 10;
 
 // --- CAD import ----------------------------------------------------------------
 // (frontend/cad_*.cpp, frontend/cad/cad_to_program.cpp; docs/import.md)
@@ -87,6 +108,13 @@ inline constexpr double kMarkerGeometryTolMm = 1e-6;
 inline constexpr double kCadResolutionMm = 1e-6;
 // Rotations after the side and offset conventions, likewise (a micro-degree).
 inline constexpr double kCadResolutionDeg = 1e-6;
+// The feeder set-up sheet of a program (backend/reports/setup_sheet.cpp)
+// finds a Pick's feeder by its pick point: the program's point (its pallet
+// corners interpolated) and the cell's are the same numbers, apart from the
+// arithmetic's rounding, when they describe the same lane. A pick farther
+// than this from every pick point of the cell is at no feeder the cell knows
+// and is reported; lanes are millimetres apart.
+inline constexpr double kFeederPickMatchMm = 0.01;
 
 // --- periphery calibration ---------------------------------------------------
 // (calibration/fixture_estimation.cpp; the C runtime runtime/c/ repeats these values
@@ -130,6 +158,12 @@ inline constexpr double kDiffDefaultThresholdUm = 10;
 // which gives up beyond kDiffMaxEditDistance edits in one function.
 inline constexpr double kDiffMaxAlignCells = 4e6;
 inline constexpr long kDiffMaxEditDistance = 2000;
+// The board poses the diff evaluates a fixture target at (calibration/
+// machine_model.h) lie this fraction of the way to the fixture's check
+// limits (max_shift_mm, max_rotation_deg): at the limits themselves a
+// runtime whose estimate differs from the board's true pose by micrometres
+// (a re-measured marker table) would refuse the scan on one side only.
+inline constexpr double kDiffPoseLimitFraction = 0.99;
 
 // A table's error "changes sign between neighbouring nodes" (the paper's
 // condition for linear interpolation, warned by table check) only where both
@@ -145,5 +179,9 @@ inline constexpr double kSignChangeMinMm = 0.005;
 inline constexpr double kOutlierScatterFactor = 10;
 inline constexpr double kOutlierNoiseFactor = 6;
 inline constexpr double kOutlierFloorMm = 0.005;
+// A node's standard error excuses its disagreement only up to this many times
+// its axis's median standard error: a node whose own measurements scatter
+// farther than that holds a bad measurement, and is the one to blame.
+inline constexpr double kOutlierNoiseCapFactor = 10;
 
 }  // namespace smtcal

@@ -6,6 +6,7 @@
 // here needs a program.
 #pragma once
 
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,7 +14,9 @@
 #include <Eigen/Core>
 
 #include "base/source.h"
+#include "calibration/cell.h"
 #include "calibration/error_table.h"
+#include "calibration/limits.h"
 
 namespace smtcal {
 
@@ -78,6 +81,9 @@ struct TruthSpec {
   std::string path;  // the truth file; empty: defaults
   TruthTables tables = TruthTables::kDerived;
   double perturbation_scale = 1;  // derived: multiplies each node's standard error
+  // derived: multiplies the departure between the nodes, whose size is the
+  // region's interpolation estimate (cell::Region::interpolation)
+  double interpolation_scale = 1;
   TruthOutside outside = TruthOutside::kField;
   double fade_mm = 10;
   // The field's size and correlation length; default: the cell's robot keys
@@ -101,5 +107,29 @@ struct TruthSpec {
   bool noise = true;
   DriftModel drift;
 };
+
+// The true field outside the tables is scaled to its largest magnitude over
+// the robot's reach, sampled on a grid every correlation length / 8 in x and
+// y (simulation/true_field.h). The grid's size along one axis and in all;
+// the cell and truth loaders refuse a correlation length that makes it more
+// than limits::kMaxTrueFieldSamples, before any work starts.
+inline double TrueFieldStepMm(double correlation_mm) {
+  return correlation_mm / limits::kTrueFieldStepsPerCorrelation;
+}
+inline double TrueFieldSamplesAlong(const cell::Interval& reach, double correlation_mm) {
+  return std::floor((reach.hi - reach.lo) / TrueFieldStepMm(correlation_mm)) + 1;
+}
+inline double TrueFieldSamples(const cell::Robot& robot, double correlation_mm) {
+  return TrueFieldSamplesAlong(robot.limits[0], correlation_mm) * TrueFieldSamplesAlong(robot.limits[1], correlation_mm);
+}
+// The smallest correlation length whose grid fits: the step s with
+// (sx / s + 1)(sy / s + 1) <= kMaxTrueFieldSamples, for the message that
+// refuses a smaller one.
+inline double MinTrueFieldCorrelationMm(const cell::Robot& robot) {
+  const double sx = robot.limits[0].hi - robot.limits[0].lo, sy = robot.limits[1].hi - robot.limits[1].lo;
+  const double n = limits::kMaxTrueFieldSamples - 1;
+  const double step = ((sx + sy) + std::sqrt((sx + sy) * (sx + sy) + 4 * n * sx * sy)) / (2 * n);
+  return step * limits::kTrueFieldStepsPerCorrelation * 1.001;
+}
 
 }  // namespace smtcal

@@ -24,11 +24,14 @@
 #include <toml++/toml.h>
 
 #include "base/field_text.h"
+#include "base/sha256.h"
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
 #include "calibration/placement_budget.h"
+#include "calibration/scan_plan.h"
 #include "calibration/tolerances.h"
+#include "calibration/truth_spec.h"
 #include "frontend/input_kind.h"
 #include "frontend/table_csv.h"
 #include "frontend/toml_source.h"
@@ -40,26 +43,12 @@ constexpr std::array<std::string_view, 4> kEdgeNames = {"p1", "p2", "p3", "p4"};
 // The robot's limits, in the order of Robot::limits.
 constexpr std::array<std::string_view, 4> kLimitKeys = {"x_mm", "y_mm", "z_mm", "u_deg"};
 constexpr std::array<std::string_view, 4> kLimitUnits = {"mm", "mm", "mm", "deg"};
+constexpr std::array<NumberRange, 4> kLimitRanges = {limits::kPositionMm, limits::kPositionMm, limits::kPositionMm,
+                                                    limits::kAngleDeg};
 // The axis words [linuxcnc] rotation_axis may name.
 constexpr std::array<std::string_view, 3> kRotationAxisNames = {"A", "B", "C"};
 
 bool SameName(std::string_view a, std::string_view b) { return AsciiLowercase(a) == AsciiLowercase(b); }
-
-// A user's string for a message: control characters as \xNN, so a name
-// cannot garble the terminal or the JSON output (toml++ has already refused
-// text that is not UTF-8).
-std::string Printable(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte == 0x7f) {
-      out += fmt::format("\\x{:02x}", byte);
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
 
 // Numbers in messages: the shortest form that reads back (0.1, 190, -2.5e-07).
 std::string Num(double value) { return fmt::format("{}", value); }
@@ -149,8 +138,10 @@ class Keys {
 
 class Loader {
  public:
-  Loader(SourceManager& sources, Diagnostics& diags, std::uint32_t file, std::filesystem::path dir)
-      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)), locator_(sources, file) {}
+  Loader(SourceManager& sources, Diagnostics& diags, std::uint32_t file, std::filesystem::path dir,
+         CellLoadOptions options)
+      : sources_(sources), diags_(diags), file_(file), dir_(std::move(dir)), options_(options),
+        locator_(sources, file) {}
 
   Diagnostics& diags() { return diags_; }
 
@@ -164,8 +155,10 @@ class Loader {
  private:
   struct LoadedTable {
     std::optional<std::string> io_error;  // the file could not be read
+    bool missing = false;                 // ... because it does not exist
     bool ok = false;                      // read and valid
     ErrorTable table;
+    std::uint32_t file = 0;               // its SourceManager id, when read
   };
   using Names = std::vector<Located<std::string>>;
 
@@ -182,21 +175,27 @@ class Loader {
   bool ReadFixtureLimits(Keys& keys, Fixture& fixture);
   std::optional<Feeder> ReadFeeder(const toml::table& table, int index, Names& names);
   std::optional<LinuxCnc> ReadLinuxCnc(const toml::table& table);
+  std::optional<Measure> ReadMeasure(const toml::table& table);
 
   bool CheckMarkerGeometry(const Fixture& fixture, Keys& keys);
   bool CheckScanTrips(const Fixture& fixture);
   void CheckTeachTrips(const Fixture& fixture);
   void CheckRegionOverlaps(const std::vector<Region>& regions);
+  void CheckTrueFieldGrid(const Robot& robot, Keys& keys);
   void CheckUniqueNames(const Names& names, std::string_view noun);
+  // cell.files: the cell file and its tables with their SHA-256.
+  void RecordFiles(Cell& cell) const;
 
   // Robot-limit checks; `robot_ok_` says whether [robot] was read cleanly.
   void CheckInLimit(int axis, double value, SourceRange where, const std::string& subject);
   void CheckPointInLimits(const std::array<double, 4>& point, SourceRange where, const std::string& subject);
+  void ReadPocket(Keys& keys, Fixture& fixture);
 
   SourceManager& sources_;
   Diagnostics& diags_;
   std::uint32_t file_;
   std::filesystem::path dir_;
+  CellLoadOptions options_;
   TomlLocator locator_;
   Robot robot_;
   bool robot_ok_ = false;
@@ -238,80 +237,60 @@ const toml::node* Lookup(Keys& keys, std::string_view key, Need need, std::strin
   return node;
 }
 
-// A finite number (a TOML integer or float) from `node`.
-std::optional<double> NumberOf(Keys& keys, const toml::node& node, const std::string& label, std::string_view expected) {
-  std::optional<double> value;
-  if (node.is_integer()) value = static_cast<double>(*node.value<std::int64_t>());
-  if (node.is_floating_point()) value = *node.value<double>();
-  if (!value) {
-    ReportWrongType(keys, node, label, expected);
-    return std::nullopt;
-  }
-  if (!std::isfinite(*value)) {
-    keys.loader().diags().Report(DiagKind::CellValueOutOfRange, keys.loader().Range(node), label, Num(*value),
-                                 "a finite number");
-    return std::nullopt;
-  }
-  return value;
+// What a number key must hold, for "must be ...": "a number in mm".
+std::string NumberExpected(const NumberRange& range) {
+  if (range.whole) return "a whole number";
+  return range.unit.empty() ? std::string("a number") : fmt::format("a number in {}", range.unit);
 }
 
-std::optional<Located<double>> Number(Keys& keys, std::string_view key, Need need, std::string_view unit) {
-  std::string expected = fmt::format("a number in {}", unit);
-  const toml::node* node = Lookup(keys, key, need, expected);
+// A number (a TOML integer or float) from `node`, inside `range`: the one
+// check of base/number_range.h, so NaN, the infinities and values no cell
+// has are reported with the range docs/cell.md states.
+// `expected` names the value in a wrong-type message when it is part of a
+// point or an interval.
+std::optional<double> NumberOf(Keys& keys, const toml::node& node, const std::string& label, const NumberRange& range,
+                               std::string_view expected = {}, std::string_view what = {}) {
+  std::optional<double> value;
+  if (node.is_integer() || (node.is_floating_point() && !range.whole)) value = TomlNumber(node);
+  if (!value) {
+    ReportWrongType(keys, node, label, expected.empty() ? NumberExpected(range) : std::string(expected));
+    return std::nullopt;
+  }
+  if (!InRange(*value, range)) {
+    keys.loader().diags().Report(DiagKind::CellValueOutOfRange, keys.loader().Range(node), label, TomlNumberText(node),
+                                 what.empty() ? RangeText(range) : fmt::format("{} ({})", RangeText(range), what));
+    return std::nullopt;
+  }
+  return *value + 0.0;  // -0 as 0
+}
+
+std::optional<Located<double>> Number(Keys& keys, std::string_view key, Need need, const NumberRange& range) {
+  const toml::node* node = Lookup(keys, key, need, NumberExpected(range));
   if (node == nullptr) return std::nullopt;
-  std::optional<double> value = NumberOf(keys, *node, Quoted(key), expected);
+  std::optional<double> value = NumberOf(keys, *node, Quoted(key), range);
   if (!value) return std::nullopt;
   return Located<double>{*value, keys.loader().Range(*node)};
 }
 
-void ReportOutOfRange(Keys& keys, std::string_view key, const Located<double>& value, std::string_view must) {
-  keys.loader().diags().Report(DiagKind::CellValueOutOfRange, value.range, Quoted(key), Num(value.value), must);
-}
-
-// A number > 0 (`unit` names it in messages). nullopt when missing or wrong.
-std::optional<double> PositiveNumber(Keys& keys, std::string_view key, std::string_view unit,
-                                     Need need = Need::kRequired) {
-  std::optional<Located<double>> value = Number(keys, key, need, unit);
+// The number of `key` in `range`; nullopt when it is missing (reported when
+// required) or wrong (reported). A new numeric key is one line:
+//   fixture.scan_speed_mm_s = NumberIn(keys, "scan_speed_mm_s", limits::kSpeedMmS).value_or(0);
+std::optional<double> NumberIn(Keys& keys, std::string_view key, const NumberRange& range,
+                               Need need = Need::kRequired) {
+  std::optional<Located<double>> value = Number(keys, key, need, range);
   if (!value) return std::nullopt;
-  if (value->value <= 0) {
-    ReportOutOfRange(keys, key, *value, fmt::format("greater than 0 {}", unit));
-    return std::nullopt;
-  }
   return value->value;
 }
 
-std::optional<double> NonNegativeNumber(Keys& keys, std::string_view key, std::string_view unit) {
-  std::optional<Located<double>> value = Number(keys, key, Need::kRequired, unit);
-  if (!value) return std::nullopt;
-  if (value->value < 0) {
-    ReportOutOfRange(keys, key, *value, fmt::format("0 {} or more", unit));
-    return std::nullopt;
-  }
-  return value->value;
-}
-
-std::optional<Located<std::int64_t>> Integer(Keys& keys, std::string_view key, Need need, std::string_view what) {
-  std::string expected = fmt::format("a whole number ({})", what);
-  const toml::node* node = Lookup(keys, key, need, expected);
+// A whole number (a TOML integer) of `key` in a whole `range`; `what` says
+// what it counts or names, for "must be a whole number (what)".
+std::optional<int> WholeIn(Keys& keys, std::string_view key, const NumberRange& range, std::string_view what) {
+  const std::string expected = fmt::format("a whole number ({})", what);
+  const toml::node* node = Lookup(keys, key, Need::kRequired, expected);
   if (node == nullptr) return std::nullopt;
-  if (!node->is_integer()) {
-    ReportWrongType(keys, *node, Quoted(key), expected);
-    return std::nullopt;
-  }
-  return Located<std::int64_t>{*node->value<std::int64_t>(), keys.loader().Range(*node)};
-}
-
-// An integer within [lo, hi].
-std::optional<int> IntegerIn(Keys& keys, std::string_view key, std::int64_t lo, std::int64_t hi, std::string_view what) {
-  std::optional<Located<std::int64_t>> value = Integer(keys, key, Need::kRequired, what);
+  std::optional<double> value = NumberOf(keys, *node, Quoted(key), range, expected, what);
   if (!value) return std::nullopt;
-  if (value->value < lo || value->value > hi) {
-    std::string must = hi == std::numeric_limits<int>::max() ? fmt::format("{} or more ({})", lo, what)
-                                                             : fmt::format("{} to {} ({})", lo, hi, what);
-    keys.loader().diags().Report(DiagKind::CellValueOutOfRange, value->range, Quoted(key), value->value, must);
-    return std::nullopt;
-  }
-  return static_cast<int>(value->value);
+  return static_cast<int>(*value);
 }
 
 std::optional<Located<std::string>> String(Keys& keys, std::string_view key, Need need, std::string_view expected) {
@@ -360,10 +339,10 @@ std::optional<int> Choice(Keys& keys, std::string_view key, const std::array<std
   return ChoiceOf(keys, *node, Quoted(key), names);
 }
 
-// An array of exactly N finite numbers: a point or an interval.
+// An array of exactly N numbers, each in its range: a point or an interval.
 template <std::size_t N>
 std::optional<std::array<double, N>> NumbersOf(Keys& keys, const toml::node& node, const std::string& label,
-                                               std::string_view expected) {
+                                               std::string_view expected, const std::array<NumberRange, N>& ranges) {
   const toml::array* array = node.as_array();
   if (array == nullptr || array->size() != N) {
     ReportWrongType(keys, node, label, expected);
@@ -372,7 +351,7 @@ std::optional<std::array<double, N>> NumbersOf(Keys& keys, const toml::node& nod
   std::array<double, N> values{};
   bool ok = true;
   for (std::size_t i = 0; i < N; ++i) {
-    std::optional<double> value = NumberOf(keys, *array->get(i), label, expected);
+    std::optional<double> value = NumberOf(keys, *array->get(i), label, ranges[i], expected);
     if (value) {
       values[i] = *value;
     } else {
@@ -387,10 +366,15 @@ std::string PointExpected(std::size_t n) {
   return n == 2 ? "a point [x, y] of numbers in mm" : "a point [x, y, z, u] of numbers (x, y, z in mm, u in degrees)";
 }
 
+// Points: x, y (and z) positions, u an angle (calibration/limits.h).
+constexpr std::array<NumberRange, 2> kPoint2Ranges = {limits::kPositionMm, limits::kPositionMm};
+constexpr std::array<NumberRange, 4> kPoint4Ranges = {limits::kPositionMm, limits::kPositionMm, limits::kPositionMm,
+                                                      limits::kAngleDeg};
+
 std::optional<Located<Point2>> Point2At(Keys& keys, std::string_view key, Need need) {
   const toml::node* node = Lookup(keys, key, need, PointExpected(2));
   if (node == nullptr) return std::nullopt;
-  std::optional<std::array<double, 2>> xy = NumbersOf<2>(keys, *node, Quoted(key), PointExpected(2));
+  std::optional<std::array<double, 2>> xy = NumbersOf<2>(keys, *node, Quoted(key), PointExpected(2), kPoint2Ranges);
   if (!xy) return std::nullopt;
   return Located<Point2>{Point2((*xy)[0], (*xy)[1]), keys.loader().Range(*node)};
 }
@@ -398,7 +382,7 @@ std::optional<Located<Point2>> Point2At(Keys& keys, std::string_view key, Need n
 std::optional<Located<std::array<double, 4>>> Point4At(Keys& keys, std::string_view key, Need need) {
   const toml::node* node = Lookup(keys, key, need, PointExpected(4));
   if (node == nullptr) return std::nullopt;
-  std::optional<std::array<double, 4>> xyzu = NumbersOf<4>(keys, *node, Quoted(key), PointExpected(4));
+  std::optional<std::array<double, 4>> xyzu = NumbersOf<4>(keys, *node, Quoted(key), PointExpected(4), kPoint4Ranges);
   if (!xyzu) return std::nullopt;
   return Located<std::array<double, 4>>{*xyzu, keys.loader().Range(*node)};
 }
@@ -418,7 +402,7 @@ std::optional<std::vector<Located<Point2>>> Point2List(Keys& keys, std::string_v
   for (std::size_t i = 0; i < array->size(); ++i) {
     const toml::node& element = *array->get(i);
     std::string label = fmt::format("point {} of '{}'", i + 1, key);
-    std::optional<std::array<double, 2>> xy = NumbersOf<2>(keys, element, label, PointExpected(2));
+    std::optional<std::array<double, 2>> xy = NumbersOf<2>(keys, element, label, PointExpected(2), kPoint2Ranges);
     if (xy) {
       points.push_back({Point2((*xy)[0], (*xy)[1]), keys.loader().Range(element)});
     } else {
@@ -429,20 +413,21 @@ std::optional<std::vector<Located<Point2>>> Point2List(Keys& keys, std::string_v
   return points;
 }
 
-// [lo, hi] with lo < hi.
-std::optional<Located<Interval>> IntervalAt(Keys& keys, std::string_view key, Need need, std::string_view unit) {
-  std::string expected = fmt::format("an interval [lo, hi] of numbers in {}", unit);
+// [lo, hi] with lo < hi, each bound in `range`.
+std::optional<Located<Interval>> IntervalAt(Keys& keys, std::string_view key, Need need, const NumberRange& range) {
+  std::string expected = fmt::format("an interval [lo, hi] of numbers in {}", range.unit);
   const toml::node* node = Lookup(keys, key, need, expected);
   if (node == nullptr) return std::nullopt;
-  std::optional<std::array<double, 2>> bounds = NumbersOf<2>(keys, *node, Quoted(key), expected);
+  std::optional<std::array<double, 2>> bounds =
+      NumbersOf<2>(keys, *node, Quoted(key), expected, std::array<NumberRange, 2>{range, range});
   if (!bounds) return std::nullopt;
-  SourceRange range = keys.loader().Range(*node);
+  SourceRange where = keys.loader().Range(*node);
   if ((*bounds)[0] >= (*bounds)[1]) {
-    keys.loader().diags().Report(DiagKind::CellEmptyInterval, range, Quoted(key), Num((*bounds)[0]),
-                                 Num((*bounds)[1]), unit);
+    keys.loader().diags().Report(DiagKind::CellEmptyInterval, where, Quoted(key), Num((*bounds)[0]),
+                                 Num((*bounds)[1]), range.unit);
     return std::nullopt;
   }
-  return Located<Interval>{Interval{(*bounds)[0], (*bounds)[1]}, range};
+  return Located<Interval>{Interval{(*bounds)[0], (*bounds)[1]}, where};
 }
 
 const toml::table* TableAt(Keys& keys, std::string_view key, Need need, std::string_view expected) {
@@ -500,38 +485,75 @@ void Loader::ReadRobot(const toml::table& table, Robot& robot) {
   if (auto model = String(keys, "model", Need::kOptional, "a string naming the robot")) robot.model = model->value;
   for (std::size_t axis = 0; axis < kLimitKeys.size(); ++axis) {
     robot.limit_keys[axis] = keys.KeyRange(kLimitKeys[axis]);
-    if (auto limit = IntervalAt(keys, kLimitKeys[axis], Need::kRequired, kLimitUnits[axis])) {
+    if (auto limit = IntervalAt(keys, kLimitKeys[axis], Need::kRequired, kLimitRanges[axis])) {
       robot.limits[axis] = limit->value;
     }
   }
-  robot.repeatability_mm = PositiveNumber(keys, "repeatability_mm", "mm").value_or(0);
-  if (auto limz = Number(keys, "safe_limz_mm", Need::kRequired, "mm")) robot.safe_limz_mm = limz->value;
-  robot.xy_speed_mm_s = PositiveNumber(keys, "xy_speed_mm_s", "mm/s").value_or(0);
-  robot.xy_accel_mm_s2 = PositiveNumber(keys, "xy_accel_mm_s2", "mm/s^2").value_or(0);
-  robot.z_speed_mm_s = PositiveNumber(keys, "z_speed_mm_s", "mm/s").value_or(0);
-  robot.z_accel_mm_s2 = PositiveNumber(keys, "z_accel_mm_s2", "mm/s^2").value_or(0);
-  robot.u_speed_deg_s = PositiveNumber(keys, "u_speed_deg_s", "deg/s").value_or(0);
-  robot.u_accel_deg_s2 = PositiveNumber(keys, "u_accel_deg_s2", "deg/s^2").value_or(0);
-  robot.pick_time_s = NonNegativeNumber(keys, "pick_time_s", "s").value_or(0);
-  robot.place_time_s = NonNegativeNumber(keys, "place_time_s", "s").value_or(0);
+  robot.repeatability_mm = NumberIn(keys, "repeatability_mm", limits::kAccuracyMm).value_or(0);
+  if (auto limz = NumberIn(keys, "safe_limz_mm", limits::kPositionMm)) robot.safe_limz_mm = *limz;
+  robot.xy_speed_mm_s = NumberIn(keys, "xy_speed_mm_s", limits::kSpeedMmS).value_or(0);
+  robot.xy_accel_mm_s2 = NumberIn(keys, "xy_accel_mm_s2", limits::kAccelerationMmS2).value_or(0);
+  robot.z_speed_mm_s = NumberIn(keys, "z_speed_mm_s", limits::kSpeedMmS).value_or(0);
+  robot.z_accel_mm_s2 = NumberIn(keys, "z_accel_mm_s2", limits::kAccelerationMmS2).value_or(0);
+  robot.u_speed_deg_s = NumberIn(keys, "u_speed_deg_s", limits::kSpeedDegS).value_or(0);
+  robot.u_accel_deg_s2 = NumberIn(keys, "u_accel_deg_s2", limits::kAccelerationDegS2).value_or(0);
+  robot.pick_time_s = NumberIn(keys, "pick_time_s", limits::kDwellS).value_or(0);
+  robot.place_time_s = NumberIn(keys, "place_time_s", limits::kDwellS).value_or(0);
   robot.uncalibrated_accuracy_range = keys.KeyRange("uncalibrated_accuracy_mm");
-  robot.uncalibrated_accuracy_mm = PositiveNumber(keys, "uncalibrated_accuracy_mm", "mm", Need::kOptional);
-  if (auto length = PositiveNumber(keys, "uncalibrated_correlation_mm", "mm", Need::kOptional)) {
+  robot.uncalibrated_accuracy_mm = NumberIn(keys, "uncalibrated_accuracy_mm", limits::kAccuracyMm, Need::kOptional);
+  if (auto length = NumberIn(keys, "uncalibrated_correlation_mm", limits::kCorrelationMm, Need::kOptional)) {
     robot.uncalibrated_correlation_mm = *length;
   }
   robot.servo_period_range = keys.KeyRange("servo_period_s");
-  if (auto period = PositiveNumber(keys, "servo_period_s", "s", Need::kOptional)) robot.servo_period_s = *period;
+  if (auto period = NumberIn(keys, "servo_period_s", limits::kServoPeriodS, Need::kOptional)) robot.servo_period_s = *period;
+  robot.final_approach_range = keys.KeyRange("final_approach_mm");
+  if (auto approach = Point2At(keys, "final_approach_mm", Need::kOptional)) {
+    const Point2& a = approach->value;
+    // Written so that a NaN fails too (every comparison with NaN is false).
+    if (!(a.x() != 0 && a.y() != 0 && a.cwiseAbs().maxCoeff() <= kMaxFinalApproachMm)) {
+      diags_.Report(DiagKind::CellValueOutOfRange, approach->range, "'final_approach_mm'",
+                    fmt::format("[{}, {}]", Num(a.x()), Num(a.y())),
+                    fmt::format("a move along both axes, each component non-zero and within ±{} mm",
+                                Num(kMaxFinalApproachMm)));
+    } else {
+      robot.final_approach_mm = a;
+    }
+  }
+  if (auto turnaround = NumberIn(keys, "probe_turnaround_s", limits::kProbeTurnaroundS, Need::kOptional)) {
+    robot.probe_turnaround_s = *turnaround;
+  }
   keys.Finish();
   robot_ = robot;
   robot_ok_ = diags_.error_count() == errors_before;
   if (robot_ok_) CheckInLimit(2, robot.safe_limz_mm, keys.KeyRange("safe_limz_mm"), "'safe_limz_mm'");
+  if (robot_ok_) CheckTrueFieldGrid(robot, keys);
+}
+
+// `smtcal simulate` samples its true field over the robot's reach every
+// uncalibrated_correlation_mm / 8 (calibration/truth_spec.h): a reach and a
+// correlation length that make that grid larger than it may be are refused
+// here, so no cell that passes `cell check` makes simulate run for hours.
+void Loader::CheckTrueFieldGrid(const Robot& robot, Keys& keys) {
+  const double samples = TrueFieldSamples(robot, robot.uncalibrated_correlation_mm);
+  if (samples <= limits::kMaxTrueFieldSamples) return;
+  const bool given = keys.Get("uncalibrated_correlation_mm") != nullptr;
+  diags_.Report(DiagKind::CellTrueFieldTooFine,
+                given ? keys.KeyRange("uncalibrated_correlation_mm") : keys.KeyRange("x_mm"),
+                Num(robot.uncalibrated_correlation_mm), given ? "" : " (the default)", Num(robot.limits[0].lo),
+                Num(robot.limits[0].hi), Num(robot.limits[1].lo), Num(robot.limits[1].hi),
+                fmt::format("{:.4g}", TrueFieldStepMm(robot.uncalibrated_correlation_mm)), fmt::format("{:.3g}", samples),
+                fmt::format("{:.0f}", limits::kMaxTrueFieldSamples),
+                fmt::format("{:.3g}", MinTrueFieldCorrelationMm(robot)));
 }
 
 void Loader::CheckInLimit(int axis, double value, SourceRange where, const std::string& subject) {
   if (!robot_ok_) return;
   const Interval& limit = robot_.limits[static_cast<std::size_t>(axis)];
   if (limit.Contains(value)) return;
-  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where, fmt::format("{} = {}", subject, Num(value)),
+  // Computed points (a scan path at the nominal pose, a pallet's far corner)
+  // are shown to 1 nm, without the noise of their arithmetic.
+  Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where,
+                                   fmt::format("{} = {}", subject, Num(std::round(value * 1e6) / 1e6)),
                                    kTaskAxisNames[static_cast<std::size_t>(axis)], Num(limit.lo), Num(limit.hi),
                                    kLimitUnits[static_cast<std::size_t>(axis)]);
   Diagnostics::AddNote(diag, robot_.limit_keys[static_cast<std::size_t>(axis)],
@@ -555,10 +577,14 @@ const Loader::LoadedTable& Loader::LoadTable(const std::string& table_path) {
   Result<std::uint32_t> file = sources_.Load(resolved);
   if (!file) {
     loaded.io_error = file.error().message;
+    std::error_code error;
+    loaded.missing = !std::filesystem::exists(resolved, error) && !error;
     return loaded;
   }
+  loaded.file = file.value();
   std::optional<ErrorTable> table = ReadErrorTable(file.value(), diags_);
-  // Warnings (sign changes, large errors) are for `smtcal table check`.
+  // Warnings (sign changes, large errors): `smtcal table check` shows each, and
+  // ReportTableWarnings sums them up for the commands that decide.
   if (table && ValidateErrorTable(*table, diags_, TableWarnings::kSkip)) {
     loaded.ok = true;
     loaded.table = std::move(*table);
@@ -574,7 +600,7 @@ bool Loader::ReadDifficulty(Keys& keys, Region& region) {
   const std::size_t errors_before = diags_.error_count();
   Keys difficulty(*this, *table, fmt::format("the difficulty table of {}", keys.what()), Range(*table));
   std::optional<int> level =
-      IntegerIn(difficulty, "level", 1, static_cast<std::int64_t>(kTaskAxisNames.size()), "L_D, the number of axes");
+      WholeIn(difficulty, "level", limits::kDifficultyLevel, "L_D, the number of axes");
   const char* axes_expected = "an array of axis names (\"x\", \"y\", \"z\", \"u\")";
   const toml::node* axes_node = Lookup(difficulty, "axes", Need::kRequired, axes_expected);
   if (axes_node != nullptr && !axes_node->is_array()) {
@@ -632,29 +658,47 @@ std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
       diags_.Report(DiagKind::CellValueOutOfRange, path->range, "'table'", "\"\"", "the path of an error table file");
     } else {
       loaded = &LoadTable(path->value);
-      if (loaded->io_error) {
+      if (loaded->missing && options_.tables_may_be_missing) {
+        region.has_table = false;
+      } else if (loaded->io_error) {
         diags_.Report(DiagKind::CellTableUnreadable, path->range, Printable(region.name), *loaded->io_error);
       } else if (!loaded->ok) {
         diags_.Report(DiagKind::CellTableInvalid, path->range, Printable(path->value), Printable(region.name));
       }
+      region.table_file = loaded->file;
     }
   }
 
   const std::size_t errors_before_bounds = diags_.error_count();
-  std::optional<Located<Interval>> x = IntervalAt(keys, "x_mm", Need::kOptional, "mm");
-  std::optional<Located<Interval>> y = IntervalAt(keys, "y_mm", Need::kOptional, "mm");
+  std::optional<Located<Interval>> x = IntervalAt(keys, "x_mm", Need::kOptional, limits::kPositionMm);
+  std::optional<Located<Interval>> y = IntervalAt(keys, "y_mm", Need::kOptional, limits::kPositionMm);
   const bool bounds_read = diags_.error_count() == errors_before_bounds;
   region.bounds_range = x ? keys.KeyRange("x_mm") : y ? keys.KeyRange("y_mm") : region.table_range;
 
   ReadDifficulty(keys, region);
   region.tolerance_range = keys.KeyRange("tolerance_mm");
-  region.tolerance_mm = PositiveNumber(keys, "tolerance_mm", "mm").value_or(0);
+  region.tolerance_mm = NumberIn(keys, "tolerance_mm", limits::kAccuracyMm).value_or(0);
   region.outside_range = keys.KeyRange("outside");
   if (std::optional<int> outside = Choice(keys, "outside", kOutsideNames)) {
     region.outside = static_cast<OutsidePolicy>(*outside);  // kOutsideNames is in OutsidePolicy's order
   }
   keys.Finish();
 
+  if (!region.has_table && bounds_read) {
+    // Planning the first measurement: the bounds say what to measure.
+    if (!x || !y) {
+      diags_.Report(DiagKind::CellRegionNeedsBounds, region.table_range, Printable(region.name),
+                    Printable(region.table_path), !x && !y ? "x_mm and y_mm" : !x ? "x_mm" : "y_mm");
+    } else {
+      region.x_mm = x->value;
+      region.y_mm = y->value;
+      std::string subject = fmt::format("region '{}'", Printable(region.name));
+      CheckInLimit(0, region.x_mm.lo, keys.KeyRange("x_mm"), subject + " x_mm.lo");
+      CheckInLimit(0, region.x_mm.hi, keys.KeyRange("x_mm"), subject + " x_mm.hi");
+      CheckInLimit(1, region.y_mm.lo, keys.KeyRange("y_mm"), subject + " y_mm.lo");
+      CheckInLimit(1, region.y_mm.hi, keys.KeyRange("y_mm"), subject + " y_mm.hi");
+    }
+  }
   if (loaded != nullptr && loaded->ok && bounds_read) {
     region.table = loaded->table;
     region.domain = TableDomain(region.table);
@@ -783,11 +827,11 @@ bool Loader::ReadFixtureLimits(Keys& keys, Fixture& fixture) {
   if (table == nullptr) return false;
   const std::size_t errors_before = diags_.error_count();
   Keys limits(*this, *table, fmt::format("[fixture.limits] of {}", keys.what()), Range(*table));
-  fixture.max_shift_mm = PositiveNumber(limits, "max_shift_mm", "mm").value_or(0);
-  fixture.max_rotation_deg = PositiveNumber(limits, "max_rotation_deg", "deg").value_or(0);
-  fixture.length_tolerance_mm = PositiveNumber(limits, "length_tolerance_mm", "mm").value_or(0);
-  fixture.squareness_deg = PositiveNumber(limits, "squareness_deg", "deg").value_or(0);
-  fixture.max_line_residual_mm = PositiveNumber(limits, "max_line_residual_mm", "mm").value_or(0);
+  fixture.max_shift_mm = NumberIn(limits, "max_shift_mm", limits::kFixtureLimitMm).value_or(0);
+  fixture.max_rotation_deg = NumberIn(limits, "max_rotation_deg", limits::kFixtureRotationDeg).value_or(0);
+  fixture.length_tolerance_mm = NumberIn(limits, "length_tolerance_mm", limits::kFixtureLimitMm).value_or(0);
+  fixture.squareness_deg = NumberIn(limits, "squareness_deg", limits::kSquarenessDeg).value_or(0);
+  fixture.max_line_residual_mm = NumberIn(limits, "max_line_residual_mm", limits::kFixtureLimitMm).value_or(0);
   limits.Finish();
   return diags_.error_count() == errors_before;
 }
@@ -877,6 +921,24 @@ void Loader::CheckTeachTrips(const Fixture& fixture) {
   }
 }
 
+// pocket_x_mm, pocket_y_mm: where `smtcal import` puts boards on this
+// fixture (docs/cell.md). Both or neither; each [lo, hi] within
+// limits::kPocketMm of the fixture origin.
+void Loader::ReadPocket(Keys& keys, Fixture& fixture) {
+  std::optional<Located<Interval>> x = IntervalAt(keys, "pocket_x_mm", Need::kOptional, limits::kPocketMm);
+  std::optional<Located<Interval>> y = IntervalAt(keys, "pocket_y_mm", Need::kOptional, limits::kPocketMm);
+  const bool has_x = keys.Get("pocket_x_mm") != nullptr, has_y = keys.Get("pocket_y_mm") != nullptr;
+  if (has_x != has_y) {
+    diags_.Report(DiagKind::CellMissingKey, keys.KeyRange(has_x ? "pocket_x_mm" : "pocket_y_mm"), keys.what(),
+                  has_x ? "pocket_y_mm" : "pocket_x_mm",
+                  "a pocket is a rectangle, pocket_x_mm = [lo, hi] and pocket_y_mm = [lo, hi] in the fixture frame");
+    return;
+  }
+  if (!x || !y) return;
+  fixture.pocket_mm = std::array<Interval, 2>{x->value, y->value};
+  fixture.pocket_range = x->range;
+}
+
 std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
                                            std::vector<Located<std::string>>& names) {
   const std::size_t errors_before = diags_.error_count();
@@ -893,34 +955,40 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   const std::size_t errors_before_pose = diags_.error_count();
   fixture.pose_range = keys.KeyRange("origin_mm");
   if (auto origin = Point2At(keys, "origin_mm", Need::kRequired)) fixture.origin_mm = origin->value;
-  if (auto angle = Number(keys, "angle_deg", Need::kOptional, "deg")) {
-    if (std::abs(angle->value) > limits::kMaxAbsAngleDeg) {
-      ReportOutOfRange(keys, "angle_deg", *angle,
-                       fmt::format("within -{0} to {0} deg", Num(limits::kMaxAbsAngleDeg)));
-    }
-    fixture.angle_deg = angle->value;
-  }
+  if (auto angle = NumberIn(keys, "angle_deg", limits::kAngleDeg, Need::kOptional)) fixture.angle_deg = *angle;
   const bool pose_ok = diags_.error_count() == errors_before_pose;
-  std::optional<double> l1 = PositiveNumber(keys, "l1_mm", "mm");
-  std::optional<double> l2 = PositiveNumber(keys, "l2_mm", "mm");
+  std::optional<double> l1 = NumberIn(keys, "l1_mm", limits::kLengthMm);
+  std::optional<double> l2 = NumberIn(keys, "l2_mm", limits::kLengthMm);
   fixture.l1_mm = l1.value_or(0);
   fixture.l2_mm = l2.value_or(0);
   const bool edges_ok = ReadEdges(keys, fixture);
   const bool paths_ok = ReadScanPaths(keys, fixture);
-  std::optional<Located<double>> scan_z = Number(keys, "scan_z_mm", Need::kRequired, "mm");
+  std::optional<Located<double>> scan_z = Number(keys, "scan_z_mm", Need::kRequired, limits::kPositionMm);
   if (scan_z) fixture.scan_z_mm = scan_z->value;
   fixture.scan_speed_range = keys.KeyRange("scan_speed_mm_s");
-  std::optional<Located<double>> place_z = Number(keys, "place_z_mm", Need::kOptional, "mm");
+  std::optional<Located<double>> place_z = Number(keys, "place_z_mm", Need::kOptional, limits::kPositionMm);
   if (place_z) {
     fixture.place_z_mm = place_z->value;
     fixture.place_z_range = keys.KeyRange("place_z_mm");
   }
-  fixture.scan_speed_mm_s = PositiveNumber(keys, "scan_speed_mm_s", "mm/s").value_or(0);
-  std::optional<double> window = PositiveNumber(keys, "trip_window_mm", "mm");
+  ReadPocket(keys, fixture);
+  fixture.scan_speed_mm_s = NumberIn(keys, "scan_speed_mm_s", limits::kSpeedMmS).value_or(0);
+  fixture.latch_speed_range = keys.KeyRange("latch_speed_mm_s");
+  if (std::optional<Located<double>> latch = Number(keys, "latch_speed_mm_s", Need::kOptional, limits::kSpeedMmS)) {
+    if (fixture.scan_speed_mm_s > 0 && latch->value > fixture.scan_speed_mm_s) {
+      diags_.Report(DiagKind::CellValueOutOfRange, latch->range, "'latch_speed_mm_s'", Num(latch->value),
+                    fmt::format("at most scan_speed_mm_s = {} mm/s: the search finds each edge at the scan "
+                                "speed, the latch measures it again slower",
+                                Num(fixture.scan_speed_mm_s)));
+    } else {
+      fixture.latch_speed_mm_s = latch->value;
+    }
+  }
+  std::optional<double> window = NumberIn(keys, "trip_window_mm", limits::kTripWindowMm);
   fixture.trip_window_mm = window.value_or(0);
-  fixture.sensor_input = IntegerIn(keys, "sensor_input", limits::kIoBitMin, limits::kIoBitMax,
-                                   "the input bit the sensor is wired to").value_or(0);
-  fixture.sensor_accuracy_mm = PositiveNumber(keys, "sensor_accuracy_mm", "mm").value_or(0);
+  fixture.sensor_input =
+      WholeIn(keys, "sensor_input", limits::kIoBit, "the input bit the sensor is wired to").value_or(0);
+  fixture.sensor_accuracy_mm = NumberIn(keys, "sensor_accuracy_mm", limits::kAccuracyMm).value_or(0);
   if (std::optional<int> estimator = Choice(keys, "estimator", kEstimatorNames)) {
     fixture.estimator = static_cast<Estimator>(*estimator);  // kEstimatorNames is in Estimator's order
   }
@@ -1008,10 +1076,9 @@ std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
     Keys pallet_keys(*this, *pallet, fmt::format("the pallet of {}", title), Range(*pallet));
     last = Point4At(pallet_keys, "last", Need::kRequired);
     back = Point4At(pallet_keys, "back", Need::kRequired);
-    std::optional<int> columns = IntegerIn(pallet_keys, "columns", limits::kPalletMinColumns,
-                                           std::numeric_limits<int>::max(), "pick points from pick to last");
-    std::optional<int> rows = IntegerIn(pallet_keys, "rows", limits::kPalletMinRows, std::numeric_limits<int>::max(),
-                                        "pick points from pick to back");
+    std::optional<int> columns =
+        WholeIn(pallet_keys, "columns", limits::kPalletCount, "pick points from pick to last");
+    std::optional<int> rows = WholeIn(pallet_keys, "rows", limits::kPalletCount, "pick points from pick to back");
     pallet_keys.Finish();
     if (last) feeder.pallet_last = last->value;
     if (back) feeder.pallet_back = back->value;
@@ -1058,8 +1125,8 @@ std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
     linuxcnc.rotation_axis = kRotationAxisNames[static_cast<std::size_t>(*axis)][0];
   }
   linuxcnc.vacuum_sensor_input =
-      IntegerIn(keys, "vacuum_sensor_input", 0, kLinuxCncMaxDio - 1, "motion.digital-in-NN").value_or(0);
-  linuxcnc.vacuum_timeout_s = PositiveNumber(keys, "vacuum_timeout_s", "s").value_or(0);
+      WholeIn(keys, "vacuum_sensor_input", limits::kLinuxCncInput, "motion.digital-in-NN").value_or(0);
+  linuxcnc.vacuum_timeout_s = NumberIn(keys, "vacuum_timeout_s", limits::kTimeoutS).value_or(0);
   // The cycle record: names LinuxCNC takes as they are written in a comment
   // (LOGOPEN, #<_hal[...]>), so no parentheses, no spaces at their ends.
   if (auto file = String(keys, "record_file", Need::kOptional, "a string: the log file's path")) {
@@ -1078,7 +1145,7 @@ std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
   }
   if (keys.Get("record_max_cycles") != nullptr) {
     linuxcnc.record_max_cycles =
-        IntegerIn(keys, "record_max_cycles", 1, kMaxRecordMaxCycles, "scans per file").value_or(kDefaultRecordMaxCycles);
+        WholeIn(keys, "record_max_cycles", limits::kRecordMaxCycles, "scans per file").value_or(kDefaultRecordMaxCycles);
   }
   if (auto pin = String(keys, "record_clock_pin", Need::kOptional, "a string: a HAL pin's name")) {
     const bool plain = !pin->value.empty() && pin->value.size() <= 47 &&
@@ -1097,6 +1164,91 @@ std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
   keys.Finish();
   if (diags_.error_count() != errors_before) return std::nullopt;
   return linuxcnc;
+}
+
+// ------------------------------------------------------------------ measure
+
+std::optional<Measure> Loader::ReadMeasure(const toml::table& table) {
+  const std::size_t errors_before = diags_.error_count();
+  Keys keys(*this, table, "[measure]", Range(table));
+  Measure m;
+  m.range = Range(table);
+  m.device_range = keys.KeyRange("device");
+  if (Lookup(keys, "device", Need::kRequired, "one of 'transducer', 'probe' or 'external'") != nullptr) {
+    if (std::optional<int> device = Choice(keys, "device", kMeasureDeviceNames)) {
+      m.device = static_cast<MeasureDevice>(*device);
+    }
+  }
+  if (auto z = Number(keys, "z_mm", Need::kRequired, limits::kPositionMm)) {
+    m.z_mm = z->value;
+    CheckInLimit(2, m.z_mm, z->range, "'z_mm' of [measure]");
+  }
+  m.clear_z_mm = robot_.safe_limz_mm;
+  if (auto clear = Number(keys, "clear_z_mm", Need::kOptional, limits::kPositionMm)) {
+    m.clear_z_mm = clear->value;
+    CheckInLimit(2, m.clear_z_mm, clear->range, "'clear_z_mm' of [measure]");
+    if (m.clear_z_mm <= m.z_mm) {
+      diags_.Report(DiagKind::CellValueOutOfRange, clear->range, "'clear_z_mm'", Num(clear->value),
+                    fmt::format("above z_mm = {}", Num(m.z_mm)));
+    }
+  }
+  if (auto dwell = NumberIn(keys, "dwell_s", limits::kMeasureDwellS, Need::kOptional)) m.dwell_s = *dwell;
+  if (auto reading = NumberIn(keys, "reading_time_s", limits::kDwellS, Need::kOptional)) m.reading_time_s = *reading;
+  m.noise_mm = NumberIn(keys, "noise_mm", limits::kAccuracyMm).value_or(0);
+  if (auto timeout = NumberIn(keys, "timeout_s", limits::kTimeoutS, Need::kOptional)) m.timeout_s = *timeout;
+  if (keys.Get("ready_input") != nullptr) {
+    m.ready_input = WholeIn(keys, "ready_input", limits::kLinuxCncInput, "motion.digital-in-NN");
+  }
+  // The device's own table: required for the device named, refused for the others.
+  for (std::size_t d = 0; d < kMeasureDeviceNames.size(); ++d) {
+    const std::string_view name = kMeasureDeviceNames[d];
+    const bool wanted = static_cast<std::size_t>(m.device) == d;
+    const toml::table* device =
+        TableAt(keys, name, wanted ? Need::kRequired : Need::kOptional, fmt::format("a [measure.{}] table", name));
+    if (device == nullptr) continue;
+    if (!wanted) {
+      diags_.Report(DiagKind::CellUnknownKey, keys.KeyRange(name), Printable(std::string(name)), "[measure]",
+                    fmt::format(" (the device is '{}': its table is [measure.{}])",
+                                kMeasureDeviceNames[static_cast<std::size_t>(m.device)],
+                                kMeasureDeviceNames[static_cast<std::size_t>(m.device)]));
+      continue;
+    }
+    Keys sub(*this, *device, fmt::format("[measure.{}]", name), Range(*device));
+    if (m.device == MeasureDevice::kTransducer) {
+      MeasureTransducer& t = m.transducer;
+      t.input = WholeIn(sub, "input", limits::kLinuxCncInput, "motion.analog-in-NN").value_or(0);
+      t.reference_input = WholeIn(sub, "reference_input", limits::kLinuxCncInput, "motion.analog-in-NN").value_or(0);
+      if (auto slope = Number(sub, "slope", Need::kRequired, limits::kTransducerSlope)) {
+        if (std::abs(slope->value) < 0.1) {
+          diags_.Report(DiagKind::CellValueOutOfRange, slope->range, "'slope'", Num(slope->value),
+                        "within 0.1 to 10 in size (a 45 degree flank: 1 or -1)");
+        } else {
+          t.slope = slope->value;
+        }
+      }
+      if (auto zero = Number(sub, "zero_mm", Need::kOptional, limits::kPositionMm)) t.zero_mm = zero->value;
+      if (auto range = IntervalAt(sub, "range_mm", Need::kRequired, limits::kPositionMm)) t.range_mm = range->value;
+      t.groove_pitch_mm = NumberIn(sub, "groove_pitch_mm", limits::kLengthMm).value_or(1);
+      t.grooves = WholeIn(sub, "grooves", limits::kTransducerGrooves, "grooves per direction").value_or(2);
+    } else if (m.device == MeasureDevice::kProbe) {
+      MeasureProbe& p = m.probe;
+      p.hole_diameter_mm = NumberIn(sub, "hole_diameter_mm", limits::kLengthMm).value_or(0);
+      p.hole_pitch_mm = NumberIn(sub, "hole_pitch_mm", limits::kLengthMm).value_or(1);
+      p.stylus_diameter_mm = NumberIn(sub, "stylus_diameter_mm", limits::kLengthMm).value_or(0);
+      p.speed_mm_s = NumberIn(sub, "speed_mm_s", limits::kSpeedMmS).value_or(1);
+      p.overtravel_mm = NumberIn(sub, "overtravel_mm", limits::kLengthMm).value_or(0.5);
+    } else {
+      MeasureExternal& e = m.external;
+      e.trigger_output = WholeIn(sub, "trigger_output", limits::kLinuxCncInput, "motion.digital-out-NN").value_or(0);
+      e.done_input = WholeIn(sub, "done_input", limits::kLinuxCncInput, "motion.digital-in-NN").value_or(0);
+      e.node_output = WholeIn(sub, "node_output", limits::kExternalNodeOutput,
+                              "motion.analog-out-NN; the set and repetition go on the next two").value_or(0);
+    }
+    sub.Finish();
+  }
+  keys.Finish();
+  if (diags_.error_count() != errors_before) return std::nullopt;
+  return m;
 }
 
 std::string DefaultCellName(const std::string& path) {
@@ -1143,6 +1295,9 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   if (const toml::table* linuxcnc = TableAt(keys, "linuxcnc", Need::kOptional, "a [linuxcnc] table")) {
     cell.linuxcnc = ReadLinuxCnc(*linuxcnc);
   }
+  if (const toml::table* measure = TableAt(keys, "measure", Need::kOptional, "a [measure] table")) {
+    cell.measure = ReadMeasure(*measure);
+  }
   keys.Finish();
 
   CheckUniqueNames(region_names, "region");
@@ -1150,7 +1305,26 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   CheckUniqueNames(feeder_names, "feeder");
   CheckRegionOverlaps(cell.regions);
   if (diags_.error_count() != errors_before) return std::nullopt;
+  for (Region& region : cell.regions) {
+    // A region planned for measuring has no table yet: nothing to estimate.
+    if (region.has_table) region.interpolation = RegionInterpolation(cell.robot, region.table);
+  }
+  RecordFiles(cell);
   return cell;
+}
+
+void Loader::RecordFiles(Cell& cell) const {
+  cell.files.push_back({false, cell.path, Sha256Hex(sources_.File(file_).text), {}});
+  for (const Region& region : cell.regions) {
+    if (!region.has_table) continue;  // planned for measuring: no table file yet
+    auto same = std::find_if(cell.files.begin() + 1, cell.files.end(),
+                             [&](const CellFile& file) { return file.path == region.table_path; });
+    if (same == cell.files.end()) {
+      cell.files.push_back({true, region.table_path, Sha256Hex(sources_.File(region.table_file).text), {}});
+      same = cell.files.end() - 1;
+    }
+    same->regions.push_back(region.name);
+  }
 }
 
 // "Error while parsing key-value pair: expected ..." -> "expected ... (while parsing key-value pair)".
@@ -1167,11 +1341,16 @@ std::string ParseErrorText(std::string_view description) {
 // ------------------------------------------------------------------ public
 
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags) {
+  return LoadCell(path, sources, diags, CellLoadOptions{});
+}
+
+Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                     const CellLoadOptions& options) {
   Result<std::uint32_t> file = sources.Load(path);
   if (!file) return file.error();
   const SourceFile& source = sources.File(file.value());
   std::filesystem::path dir = path == "-" ? std::filesystem::path() : std::filesystem::path(path).parent_path();
-  Loader loader(sources, diags, file.value(), dir);
+  Loader loader(sources, diags, file.value(), dir, options);
   toml::table root;
   try {
     root = toml::parse(std::string_view(source.text), std::string_view(source.name));
@@ -1206,16 +1385,46 @@ static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostic
                   fmt::format("{:.3f}", windows[k].nominal.x()), fmt::format("{:.3f}", windows[k].nominal.y()),
                   Num(fixture.trip_window_mm), accuracy);
   }
-  const double late_mm = fixture.scan_speed_mm_s * cell.robot.servo_period_s;
+  const double late_mm = fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s;
   if (late_mm > 0.25 * fixture.max_line_residual_mm) {
-    diags.Report(DiagKind::CellTripLatency, fixture.scan_speed_range, Printable(fixture.name),
-                  Num(fixture.scan_speed_mm_s), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
-                  Num(fixture.max_line_residual_mm));
+    const bool two_stage = fixture.latch_speed_mm_s > 0;
+    diags.Report(DiagKind::CellTripLatency, two_stage ? fixture.latch_speed_range : fixture.scan_speed_range,
+                  Printable(fixture.name), two_stage ? "latches its trips" : "scans",
+                  Num(fixture.TripLatchSpeedMmS()), Num(cell.robot.servo_period_s), fmt::format("{:.4g}", late_mm),
+                  Num(fixture.max_line_residual_mm), two_stage ? "latch_speed_mm_s" : "scan_speed_mm_s");
+  }
+  const CaptureRange capture = ScanCaptureRange(fixture);
+  if (capture.factor < 1) {
+    const ScanPath& first = fixture.scan_paths.front();
+    diags.Report(DiagKind::CellScanCaptureRange, first.range, Printable(fixture.name),
+                  fmt::format("{:.2f}", capture.shift_mm), fmt::format("{:.2f}", capture.rotation_deg),
+                  fmt::format("{:.2f}", capture.factor), capture.limited_by, Num(fixture.max_shift_mm),
+                  Num(fixture.max_rotation_deg));
   }
 }
 
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags) {
   for (const Fixture& fixture : cell.fixtures) CheckScanErrors(fixture, cell, diags);
+}
+
+void ReportTableWarnings(const Cell& cell, Diagnostics& diags) {
+  std::vector<std::string> reported;  // table files, as loaded
+  for (const Region& region : cell.regions) {
+    if (std::find(reported.begin(), reported.end(), region.table.name) != reported.end()) continue;
+    reported.push_back(region.table.name);
+    std::string summary;
+    for (const std::string& line : SummarizeTableWarnings(region.table)) summary += (summary.empty() ? "" : "; ") + line;
+    if (summary.empty()) continue;
+    diags.Report(DiagKind::CellTableWarnings, region.table_range, Printable(region.table_path), Printable(region.name),
+                 summary, Printable(region.table.name));
+  }
+}
+
+void ReportGridAdvice(const Cell& cell, Diagnostics& diags) {
+  for (const Region& region : cell.regions) {
+    ReportCoarseGrid(region.interpolation, region.tolerance_mm,
+                     fmt::format("region '{}''s table", Printable(region.name)), region.table_range, diags);
+  }
 }
 
 }  // namespace smtcal::cell

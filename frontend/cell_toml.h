@@ -20,6 +20,16 @@ namespace smtcal::cell {
 // value is nullopt. `sources` must be the SourceManager `diags` renders with.
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags);
 
+// How a cell is loaded for planning its measurement (`smtcal measure plan`):
+// a region's table file that does not exist yet is no error (the region gets
+// has_table = false and must give its bounds x_mm and y_mm); a table that
+// exists is read and validated as always (it is the previous measurement).
+struct CellLoadOptions {
+  bool tables_may_be_missing = false;
+};
+Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                     const CellLoadOptions& options);
+
 
 // Warnings on a loaded cell's marker scans (`smtcal cell check`): every trip
 // whose window lies outside every region's table (CellTripUncalibrated: the
@@ -27,5 +37,16 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
 // latch later than a quarter of the fixture's max_line_residual_mm
 // (CellTripLatency). verify covers both in its budgets.
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags);
+
+// The warnings of the cell's error tables (sign changes, errors over half the
+// pitch: what `smtcal table check` shows in full), summarised once per table
+// at the first region that uses it (CellTableWarnings): for the commands
+// that decide (cell check, verify, compile).
+void ReportTableWarnings(const Cell& cell, Diagnostics& diags);
+
+// The grid advice of every region whose interpolation estimate is more than
+// kInterpolationShareOfTolerance of its tolerance (InterpolationCoarse, at
+// its table key): for `smtcal cell check`.
+void ReportGridAdvice(const Cell& cell, Diagnostics& diags);
 
 }  // namespace smtcal::cell

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "base/field_text.h"
+#include "base/number_range.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_text.h"
@@ -84,23 +85,47 @@ class Reader {
     return *node->value<std::string>();
   }
 
-  std::optional<double> Number(const toml::table& table, std::string_view key, double limit, std::string_view unit) {
+  // A number in `range`: the one check of base/number_range.h.
+  std::optional<double> NumberOf(const toml::node& node, const std::string& label, const NumberRange& range) {
+    const double value = TomlNumber(node);
+    if (!InRange(value, range)) {
+      diags_.Report(DiagKind::FeedersBadValue, Range(node), label, RangeText(range), TomlNumberText(node));
+      return std::nullopt;
+    }
+    return value + 0.0;  // -0 as 0
+  }
+
+  // A string or a non-empty array of strings; empty when the key is absent
+  // (or wrong, which is reported).
+  std::vector<std::string> Patterns(const toml::table& table, std::string_view key, std::string_view expected) {
+    std::vector<std::string> patterns;
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return patterns;
+    if (node->is_string()) {
+      patterns.push_back(*node->value<std::string>());
+    } else if (const toml::array* list = node->as_array();
+               list != nullptr && !list->empty() &&
+               std::all_of(list->begin(), list->end(), [](const toml::node& n) { return n.is_string(); })) {
+      for (const toml::node& item : *list) patterns.push_back(*item.value<std::string>());
+    } else {
+      diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, expected, TomlTypeName(*node));
+    }
+    return patterns;
+  }
+
+  std::optional<double> Number(const toml::table& table, std::string_view key, const NumberRange& range) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_number()) {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a number", TomlTypeName(*node));
       return std::nullopt;
     }
-    double value = *node->value<double>();
-    if (!std::isfinite(value) || std::abs(value) > limit) {
-      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, fmt::format("within ±{} {}", limit, unit),
-                    fmt::format("{}", value));
-      return std::nullopt;
-    }
-    return value;
+    return NumberOf(*node, std::string(key), range);
   }
 
-  std::optional<int> Count(const toml::table& table, std::string_view key, SourceRange* range = nullptr) {
+  // A whole number in `whole`: pallet columns or rows, a lane.
+  std::optional<int> Count(const toml::table& table, std::string_view key, const NumberRange& whole,
+                           SourceRange* range = nullptr) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
     if (range != nullptr) *range = Range(*node);
@@ -108,12 +133,9 @@ class Reader {
       diags_.Report(DiagKind::FeedersWrongType, Range(*node), key, "a whole number", TomlTypeName(*node));
       return std::nullopt;
     }
-    std::int64_t value = *node->value<std::int64_t>();
-    if (value < 1 || value > (1 << 20)) {
-      diags_.Report(DiagKind::FeedersBadValue, Range(*node), key, "a whole number of at least 1", value);
-      return std::nullopt;
-    }
-    return static_cast<int>(value);
+    std::optional<double> value = NumberOf(*node, std::string(key), whole);
+    if (!value) return std::nullopt;
+    return static_cast<int>(*value);
   }
 
   // [x, y, z, u]: mm and degrees in the robot base frame.
@@ -128,14 +150,11 @@ class Reader {
       return std::nullopt;
     }
     std::array<double, 4> point{};
-    for (std::size_t i = 0; i < 4; ++i) point[i] = *array->get(i)->value<double>();
     for (std::size_t i = 0; i < 4; ++i) {
-      double limit = i == 3 ? limits::kMaxAbsAngleDeg : kMaxLengthMm;
-      if (!std::isfinite(point[i]) || std::abs(point[i]) > limit) {
-        diags_.Report(DiagKind::FeedersBadValue, Range(*array->get(i)), fmt::format("{}[{}]", key, i + 1),
-                      fmt::format("within ±{} {}", limit, i == 3 ? "deg" : "mm"), fmt::format("{}", point[i]));
-        return std::nullopt;
-      }
+      std::optional<double> value = NumberOf(*array->get(i), fmt::format("{}[{}]", key, i + 1),
+                                             i == 3 ? limits::kAngleDeg : limits::kPositionMm);
+      if (!value) return std::nullopt;
+      point[i] = *value;
     }
     return point;
   }
@@ -149,28 +168,16 @@ class Reader {
     if (!table.contains("name")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'name'");
     if (std::optional<std::array<double, 4>> pick = Point(table, "pick")) feeder.pick = *pick;
     if (!table.contains("pick")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'pick'");
-    if (const toml::node* package = table.get("package")) {
-      if (package->is_string()) {
-        feeder.packages.push_back(*package->value<std::string>());
-      } else if (const toml::array* list = package->as_array();
-                 list != nullptr && !list->empty() &&
-                 std::all_of(list->begin(), list->end(), [](const toml::node& n) { return n.is_string(); })) {
-        for (const toml::node& item : *list) feeder.packages.push_back(*item.value<std::string>());
-      } else {
-        diags_.Report(DiagKind::FeedersWrongType, Range(*package), "package",
-                      "a package name or an array of package names", TomlTypeName(*package));
-      }
-    }
+    feeder.packages = Patterns(table, "package", "a package name or an array of package names");
     if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
-    feeder.rotation_offset_deg =
-        Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    feeder.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
     if (const toml::node* node = table.get("pallet")) {
       if (const toml::table* pallet = node->as_table()) {
         CheckKeys(*pallet, "the pallet", {"last", "back", "columns", "rows"});
         feeder.pallet_last = Point(*pallet, "last");
         feeder.pallet_back = Point(*pallet, "back");
-        feeder.columns = Count(*pallet, "columns").value_or(1);
-        feeder.rows = Count(*pallet, "rows").value_or(1);
+        feeder.columns = Count(*pallet, "columns", limits::kPalletCount).value_or(1);
+        feeder.rows = Count(*pallet, "rows", limits::kPalletCount).value_or(1);
         for (std::string_view key : {"last", "back", "columns", "rows"}) {
           if (!pallet->contains(key)) {
             diags_.Report(DiagKind::FeedersMissingKey, Range(*node), "the pallet", fmt::format("'{}'", key));
@@ -206,15 +213,15 @@ class Reader {
     CheckKeys(table, "[[map]]", {"feeder", "lane", "package", "value", "designator", "rotation_offset_deg"});
     if (std::optional<std::string> feeder = String(table, "feeder", &rule.feeder_range)) rule.feeder = *feeder;
     if (!table.contains("feeder")) diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]", "'feeder'");
-    rule.package = String(table, "package").value_or("");
-    rule.value = String(table, "value").value_or("");
-    rule.designator = String(table, "designator").value_or("");
+    rule.packages = Patterns(table, "package", "a package (a chip size or a glob) or an array of them");
+    rule.values = Patterns(table, "value", "a value (a glob) or an array of them");
+    rule.designators = Patterns(table, "designator", "a designator (a glob) or an array of them");
     if (!table.contains("package") && !table.contains("value") && !table.contains("designator")) {
       diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]",
                     "'package', 'value' or 'designator' to say which parts it maps");
     }
-    rule.lane = Count(table, "lane", &rule.lane_range);
-    rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kMaxAbsAngleDeg, "deg").value_or(0.0);
+    rule.lane = Count(table, "lane", limits::kPalletPickPoint, &rule.lane_range);
+    rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
     if (diags_.error_count() != errors_before) return std::nullopt;
     return rule;
   }
@@ -337,9 +344,12 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
 std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
   for (std::size_t r = 0; r < rules_.size(); ++r) {
     const FeederRule& rule = rules_[r];
-    if (!rule.package.empty() && !PackageMatch(rule.package, row.package)) continue;
-    if (!rule.value.empty() && !GlobMatch(rule.value, row.value)) continue;
-    if (!rule.designator.empty() && !GlobMatch(rule.designator, row.designator)) continue;
+    auto any = [](const std::vector<std::string>& patterns, auto&& match) {
+      return patterns.empty() || std::any_of(patterns.begin(), patterns.end(), match);
+    };
+    if (!any(rule.packages, [&](const std::string& p) { return PackageMatch(p, row.package); })) continue;
+    if (!any(rule.values, [&](const std::string& p) { return GlobMatch(p, row.value); })) continue;
+    if (!any(rule.designators, [&](const std::string& p) { return GlobMatch(p, row.designator); })) continue;
     return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg};
   }
   std::optional<FeederMatch> best;

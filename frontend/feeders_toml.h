@@ -15,9 +15,9 @@
 //   [[map]]                             # first matching rule wins
 //   feeder = "Bank1"                    # a feeder of the cell or of this file
 //   lane = 3                            # a pallet feeder's pick point k (Pallet(n, k)); default: next pocket
-//   package = "R_0603*"                 # at least one of package, value, designator
-//   value = "10k"
-//   designator = "R*"
+//   package = "R_0603*"                 # at least one of package, value, designator;
+//   value = "10k"                       # each a glob or an array of globs
+//   designator = ["R1", "R2", "R7*"]
 //   rotation_offset_deg = 90.0
 //
 // A part goes to the first [[map]] that matches it; else to the feeder whose
@@ -68,9 +68,11 @@ struct FeederRule {
   std::string feeder;
   SourceRange feeder_range;
   SourceRange range;
-  std::string package;     // globs; empty = any
-  std::string value;
-  std::string designator;
+  // Globs, each a string or an array in the file (a part matches when one of
+  // them matches); empty = any.
+  std::vector<std::string> packages;
+  std::vector<std::string> values;
+  std::vector<std::string> designators;
   std::optional<int> lane;  // 1-based pick point of a pallet feeder
   SourceRange lane_range;
   double rotation_offset_deg = 0;
@@ -108,7 +110,7 @@ class FeederTable {
   // package and the value, and its answers can be cached by them).
   bool matches_designators() const {
     for (const FeederRule& rule : rules_) {
-      if (!rule.designator.empty()) return true;
+      if (!rule.designators.empty()) return true;
     }
     return false;
   }

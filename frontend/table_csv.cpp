@@ -33,10 +33,16 @@ struct Schema {
 };
 
 const Schema kTableSchema{
-    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n"}, 4, false};
+    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n", "kind"}, 4, false};
 const Schema kRawSchema{
-    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm"}, 6, false};
+    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm", "kind"}, 6,
+    false};
 const Schema kPointSchema{"a point list", "point", {"x_mm", "y_mm"}, 2, true};
+const Schema kPlanSchema{"a measurement plan", "visit",
+                         {"visit", "region", "axes", "station", "kind", "node", "x_mm", "y_mm", "set", "repetitions"},
+                         10, false};
+const Schema kExternalSchema{
+    "an external system's readings", "reading", {"node", "set", "repetition", "x_mm", "y_mm"}, 5, false};
 
 std::string JoinColumns(const Schema& schema, std::size_t count, std::string_view separator = ", ") {
   std::string text;
@@ -177,6 +183,19 @@ class Row {
     return std::nullopt;
   }
 
+  // The optional `kind` column: node (also when the column or the field is
+  // empty) or check.
+  std::optional<ReadingKind> Kind(std::size_t column) {
+    const CsvField* field = Field(column);
+    if (field == nullptr || field->text.empty()) return ReadingKind::kNode;
+    std::string name = AsciiLowercase(field->text);
+    if (name == "node") return ReadingKind::kNode;
+    if (name == "check") return ReadingKind::kCheck;
+    diags_.Report(DiagKind::TableBadKind, field->range, Printable(field->text));
+    ok = false;
+    return std::nullopt;
+  }
+
   // A finite length in mm, within +-kMaxLengthMm. `optional_column`: an empty
   // or absent field is nullopt.
   std::optional<double> Number(std::size_t column, bool optional_column = false) {
@@ -219,6 +238,30 @@ class Row {
       return std::nullopt;
     }
     return value;
+  }
+
+  // A non-empty text field.
+  std::optional<std::string> Text(std::size_t column) {
+    const CsvField* field = Field(column);
+    if (!Present(column, field)) return std::nullopt;
+    return field->text;
+  }
+
+  // One of `names` (case-insensitive); its index.
+  std::optional<std::size_t> Choice(std::size_t column, const std::vector<std::string_view>& names) {
+    const CsvField* field = Field(column);
+    if (!Present(column, field)) return std::nullopt;
+    std::string text = AsciiLowercase(field->text);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (text == names[i]) return i;
+    }
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      list += fmt::format("{}'{}'", i == 0 ? "" : i + 1 == names.size() ? " or " : ", ", names[i]);
+    }
+    diags_.Report(DiagKind::CsvBadChoice, field->range, Printable(field->text), schema_.columns[column], list);
+    ok = false;
+    return std::nullopt;
   }
 
   bool ok = true;
@@ -339,10 +382,11 @@ std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
 }
 
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kError, kStddev, kCount };
+  enum { kAxis, kX, kY, kError, kStddev, kCount, kKind };
   auto read_row = [&](Row& row, const CsvRecord&) -> std::optional<TableNode> {
     TableNode node;
     std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<ReadingKind> kind = row.Kind(kKind);
     std::optional<double> x = row.Number(kX), y = row.Number(kY), error = row.Number(kError);
     node.stddev_mm = row.Number(kStddev, true);
     std::optional<long long> count = row.Count(kCount, 1, true);
@@ -351,6 +395,7 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
       diags.Report(DiagKind::TableNegativeStddev, row.Range(kStddev), row.Field(kStddev)->text);
       return std::nullopt;
     }
+    node.kind = *kind;
     node.axis = *axis;
     node.x_mm = *x;
     node.y_mm = *y;
@@ -367,14 +412,16 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
 }
 
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kSet, kRepetition, kError };
+  enum { kAxis, kX, kY, kSet, kRepetition, kError, kKind };
   auto read_row = [](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
     std::optional<TableAxis> axis = row.Axis(kAxis);
+    std::optional<ReadingKind> kind = row.Kind(kKind);
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
     std::optional<double> error = row.Number(kError);
     if (!row.ok) return std::nullopt;
     RawMeasurement m;
+    m.kind = *kind;
     m.axis = *axis;
     m.x_mm = *x;
     m.y_mm = *y;
@@ -401,6 +448,57 @@ std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics&
     return PointRow{Eigen::Vector2d(*x, *y), SourceRange(SourceLoc{file, record.line, begin}, end - begin)};
   };
   return ReadRows<PointRow>(file, kPointSchema, diags, read_row);
+}
+
+std::optional<std::vector<PlanRow>> ReadMeasurementPlan(std::uint32_t file, Diagnostics& diags) {
+  enum { kVisit, kRegion, kAxes, kStation, kKind, kNode, kX, kY, kSet, kRepetitions };
+  auto read_row = [](Row& row, const CsvRecord& record) -> std::optional<PlanRow> {
+    PlanRow plan;
+    std::optional<long long> visit = row.Count(kVisit, 1), station = row.Count(kStation, 1),
+                             node = row.Count(kNode, 1), set = row.Count(kSet, 1),
+                             repetitions = row.Count(kRepetitions, 1);
+    std::optional<std::string> region = row.Text(kRegion);
+    std::optional<std::size_t> axes = row.Choice(kAxes, {"x", "y", "xy"});
+    std::optional<std::size_t> kind = row.Choice(kKind, {"node", "check"});
+    std::optional<double> x = row.Number(kX), y = row.Number(kY);
+    if (!row.ok) return std::nullopt;
+    constexpr long long kMaxCount = 1 << 30;
+    auto small = [&](long long value) { return static_cast<int>(std::min(value, kMaxCount)); };
+    plan.visit = small(*visit);
+    plan.region = *region;
+    plan.axes = static_cast<measure::MeasuredAxes>(*axes);
+    plan.station = small(*station);
+    plan.kind = static_cast<measure::VisitKind>(*kind);
+    plan.node = small(*node);
+    plan.at = Eigen::Vector2d(*x, *y);
+    plan.set = small(*set);
+    plan.repetitions = small(*repetitions);
+    plan.line = record.line;
+    plan.visit_field = row.Range(kVisit);
+    plan.region_field = row.Range(kRegion);
+    plan.node_field = row.Range(kNode);
+    return plan;
+  };
+  return ReadRows<PlanRow>(file, kPlanSchema, diags, read_row);
+}
+
+std::optional<std::vector<ExternalReading>> ReadExternalReadings(std::uint32_t file, Diagnostics& diags) {
+  enum { kNode, kSet, kRepetition, kX, kY };
+  auto read_row = [](Row& row, const CsvRecord& record) -> std::optional<ExternalReading> {
+    std::optional<long long> node = row.Count(kNode, 1), set = row.Count(kSet, 1),
+                             repetition = row.Count(kRepetition, 1);
+    std::optional<double> x = row.Number(kX), y = row.Number(kY);
+    if (!row.ok) return std::nullopt;
+    ExternalReading reading;
+    reading.node = *node;
+    reading.set = *set;
+    reading.repetition = *repetition;
+    reading.at = Eigen::Vector2d(*x, *y);
+    reading.line = record.line;
+    reading.range = row.Range(kNode);
+    return reading;
+  };
+  return ReadRows<ExternalReading>(file, kExternalSchema, diags, read_row);
 }
 
 }  // namespace smtcal

@@ -22,6 +22,7 @@
 #include "base/diagnostics.h"
 #include "calibration/error_table.h"
 #include "calibration/error_table_build.h"
+#include "calibration/measurement_plan.h"
 
 namespace smtcal {
 
@@ -41,13 +42,13 @@ struct CsvRecord {
 // and left out.
 std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags);
 
-// An error table: axis,x_mm,y_mm,error_mm[,stddev_mm][,n], one row per node
-// and axis, rows in any order. Reports everything wrong with the rows and the
+// An error table: axis,x_mm,y_mm,error_mm[,stddev_mm][,n][,kind], one row
+// per node and axis (and per check point: kind = check), rows in any order. Reports everything wrong with the rows and the
 // grid (AssembleErrorTable); nullopt when anything was an error. The table is
 // not validated yet (ValidateErrorTable).
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags);
 
-// Raw measurements: axis,x_mm,y_mm,set,repetition,error_mm.
+// Raw measurements: axis,x_mm,y_mm,set,repetition,error_mm[,kind].
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags);
 
 // A point list: x_mm,y_mm (the header may be left out).
@@ -56,5 +57,37 @@ struct PointRow {
   SourceRange range;  // from the first to the last field of the row
 };
 std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics& diags);
+
+// A measurement plan (`smtcal measure plan`, docs/measure.md):
+// visit,region,axes,station,kind,node,x_mm,y_mm,set,repetitions, one row
+// per visit in the order the visits are made. The rows as written; checking
+// them against the cell is measure::PlanFromRows's.
+struct PlanRow {
+  int visit = 0;
+  std::string region;
+  measure::MeasuredAxes axes = measure::MeasuredAxes::kXY;
+  int station = 1;
+  measure::VisitKind kind = measure::VisitKind::kNode;
+  int node = 0;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  int set = 1;
+  int repetitions = 1;
+  std::uint32_t line = 0;
+  SourceRange visit_field, region_field, node_field;
+};
+std::optional<std::vector<PlanRow>> ReadMeasurementPlan(std::uint32_t file, Diagnostics& diags);
+
+// An external system's readings: node,set,repetition,x_mm,y_mm, the
+// position it measured (robot base frame) for the node, set and repetition
+// the measuring program showed it (docs/measure.md).
+struct ExternalReading {
+  long long node = 0;
+  long long set = 0;
+  long long repetition = 0;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  std::uint32_t line = 0;
+  SourceRange range;  // its node field
+};
+std::optional<std::vector<ExternalReading>> ReadExternalReadings(std::uint32_t file, Diagnostics& diags);
 
 }  // namespace smtcal

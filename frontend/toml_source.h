@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "base/diagnostics.h"
@@ -24,6 +26,20 @@ inline std::string_view TomlTypeName(const toml::node& node) {
     case toml::node_type::table: return "a table";
     default: return "a date or time";
   }
+}
+
+// The value of a number node (is_number()): an integer as the double nearest
+// to it (toml++'s value<double>() gives none for an integer it cannot hold
+// exactly), a float as it is.
+inline double TomlNumber(const toml::node& node) {
+  if (node.is_integer()) return static_cast<double>(*node.value<std::int64_t>());
+  return *node.value<double>();
+}
+// ... and as a message quotes it: an integer as written (9223372036854775807,
+// not 9.223372036854776e+18), a float in its shortest form (-0 as -0).
+inline std::string TomlNumberText(const toml::node& node) {
+  if (node.is_integer()) return std::to_string(*node.value<std::int64_t>());
+  return fmt::format("{}", *node.value<double>());
 }
 
 class TomlLocator {

@@ -10,6 +10,9 @@
 #include <toml++/toml.h>
 
 #include "base/field_text.h"
+#include "base/number_range.h"
+#include "calibration/limits.h"
+#include "calibration/truth_spec.h"
 #include "calibration/error_table_check.h"
 #include "frontend/table_csv.h"
 #include "frontend/input_kind.h"
@@ -47,15 +50,16 @@ class Reader {
     if (const toml::table* board = Table(root, "board")) ReadBoard(*board, spec.board);
     if (const toml::table* sensor = Table(root, "sensor")) {
       CheckKeys(*sensor, "[sensor]", {"accuracy_mm"});
-      spec.sensor_accuracy_mm = Number(*sensor, "accuracy_mm", 0, 5, "mm");
+      spec.sensor_accuracy_mm = Number(*sensor, "accuracy_mm", Closed(0, 5, "mm"));
     }
     if (const toml::table* robot = Table(root, "robot")) {
       CheckKeys(*robot, "[robot]",
                 {"repeatability_mm", "uncalibrated_accuracy_mm", "uncalibrated_correlation_mm", "servo_period_s"});
-      spec.repeatability_mm = Number(*robot, "repeatability_mm", 0, 5, "mm");
-      spec.uncalibrated_accuracy_mm = Number(*robot, "uncalibrated_accuracy_mm", 0, 10, "mm");
-      spec.uncalibrated_correlation_mm = Number(*robot, "uncalibrated_correlation_mm", 0.1, 1e4, "mm");
-      spec.servo_period_s = Number(*robot, "servo_period_s", 0, 1, "s");
+      spec.repeatability_mm = Number(*robot, "repeatability_mm", Closed(0, 5, "mm"));
+      spec.uncalibrated_accuracy_mm = Number(*robot, "uncalibrated_accuracy_mm", Closed(0, 10, "mm"));
+      spec.uncalibrated_correlation_mm = Number(*robot, "uncalibrated_correlation_mm", limits::kCorrelationMm);
+      if (spec.uncalibrated_correlation_mm) CheckTrueFieldGrid(*robot, *spec.uncalibrated_correlation_mm);
+      spec.servo_period_s = Number(*robot, "servo_period_s", Closed(0, 1, "s"));
     }
     if (const toml::table* drift = Table(root, "drift")) ReadDrift(*drift, spec.drift);
     for (const toml::table* region : Tables(root, "region")) ReadRegion(*region, spec);
@@ -66,20 +70,21 @@ class Reader {
  private:
   void ReadField(const toml::table& table, TruthSpec& spec) {
     CheckKeys(table, "[field]",
-              {"tables", "perturbation_scale", "outside", "fade_mm", "offset_mm", "rotation_deg", "about_mm",
-               "scale_ppm"});
+              {"tables", "perturbation_scale", "interpolation_scale", "outside", "fade_mm", "offset_mm",
+               "rotation_deg", "about_mm", "scale_ppm"});
     if (std::optional<int> tables = Choice(table, "tables", {"derived", "cell", "none"})) {
       spec.tables = static_cast<TruthTables>(*tables);
     }
-    spec.perturbation_scale = Number(table, "perturbation_scale", 0, 100, "").value_or(spec.perturbation_scale);
+    spec.perturbation_scale = Number(table, "perturbation_scale", Closed(0, 100, "")).value_or(spec.perturbation_scale);
+    spec.interpolation_scale = Number(table, "interpolation_scale", Closed(0, 100, "")).value_or(spec.interpolation_scale);
     if (std::optional<int> outside = Choice(table, "outside", {"field", "fade", "clamp"})) {
       spec.outside = static_cast<TruthOutside>(*outside);
     }
-    spec.fade_mm = Number(table, "fade_mm", 0, 1000, "mm").value_or(spec.fade_mm);
+    spec.fade_mm = Number(table, "fade_mm", Closed(0, 1000, "mm")).value_or(spec.fade_mm);
     spec.offset_mm = Point(table, "offset_mm", 10).value_or(spec.offset_mm);
-    spec.rotation_deg = Number(table, "rotation_deg", -5, 5, "deg").value_or(spec.rotation_deg);
+    spec.rotation_deg = Number(table, "rotation_deg", Closed(-5, 5, "deg")).value_or(spec.rotation_deg);
     spec.about_mm = Point(table, "about_mm", 1e5).value_or(spec.about_mm);
-    spec.scale_ppm = Number(table, "scale_ppm", -1e4, 1e4, "ppm").value_or(spec.scale_ppm);
+    spec.scale_ppm = Number(table, "scale_ppm", Closed(-1e4, 1e4, "ppm")).value_or(spec.scale_ppm);
   }
 
   void ReadBoard(const toml::table& table, BoardPoseModel& board) {
@@ -89,12 +94,12 @@ class Reader {
     if (std::optional<int> shift = Choice(table, "shift", {"exponential", "normal", "uniform", "fixed"})) {
       board.shift = static_cast<ShiftDistribution>(*shift);
     }
-    board.shift_scale_mm = Number(table, "shift_scale_mm", 0, 10, "mm").value_or(board.shift_scale_mm);
-    board.shift_max_mm = Number(table, "shift_max_mm", 0, 50, "mm").value_or(board.shift_max_mm);
+    board.shift_scale_mm = Number(table, "shift_scale_mm", Closed(0, 10, "mm")).value_or(board.shift_scale_mm);
+    board.shift_max_mm = Number(table, "shift_max_mm", Closed(0, 50, "mm")).value_or(board.shift_max_mm);
     board.fixed_shift_mm = Point(table, "fixed_shift_mm", 50).value_or(board.fixed_shift_mm);
-    board.rotation_sd_deg = Number(table, "rotation_sd_deg", 0, 5, "deg").value_or(board.rotation_sd_deg);
-    board.rotation_max_deg = Number(table, "rotation_max_deg", 0, 10, "deg").value_or(board.rotation_max_deg);
-    board.fixed_rotation_deg = Number(table, "fixed_rotation_deg", -10, 10, "deg").value_or(board.fixed_rotation_deg);
+    board.rotation_sd_deg = Number(table, "rotation_sd_deg", Closed(0, 5, "deg")).value_or(board.rotation_sd_deg);
+    board.rotation_max_deg = Number(table, "rotation_max_deg", Closed(0, 10, "deg")).value_or(board.rotation_max_deg);
+    board.fixed_rotation_deg = Number(table, "fixed_rotation_deg", Closed(-10, 10, "deg")).value_or(board.fixed_rotation_deg);
   }
 
   void ReadDrift(const toml::table& table, DriftModel& drift) {
@@ -221,27 +226,24 @@ class Reader {
     return std::nullopt;
   }
 
-  std::optional<double> NumberOf(const toml::node& node, std::string_view key, double lo, double hi,
-                                 std::string_view unit) {
+  // A number in `range`: the one check of base/number_range.h.
+  std::optional<double> NumberOf(const toml::node& node, std::string_view key, const NumberRange& range) {
     if (!node.is_number()) {
       diags_.Report(DiagKind::TruthWrongType, Range(node), key, "a number", TomlTypeName(node));
       return std::nullopt;
     }
-    const double value = *node.value<double>();
-    if (!std::isfinite(value) || value < lo || value > hi) {
-      std::string unit_text = unit.empty() ? "" : fmt::format(" {}", unit);
-      diags_.Report(DiagKind::TruthBadValue, Range(node), key, fmt::format("within {}..{}{}", lo, hi, unit_text),
-                    fmt::format("{}", value));
+    const double value = TomlNumber(node);
+    if (!InRange(value, range)) {
+      diags_.Report(DiagKind::TruthBadValue, Range(node), key, RangeText(range), TomlNumberText(node));
       return std::nullopt;
     }
-    return value;
+    return value + 0.0;  // -0 as 0
   }
 
-  std::optional<double> Number(const toml::table& table, std::string_view key, double lo, double hi,
-                               std::string_view unit) {
+  std::optional<double> Number(const toml::table& table, std::string_view key, const NumberRange& range) {
     const toml::node* node = table.get(key);
     if (node == nullptr) return std::nullopt;
-    return NumberOf(*node, key, lo, hi, unit);
+    return NumberOf(*node, key, range);
   }
 
   // [x, y] in mm, each within +-limit.
@@ -254,10 +256,25 @@ class Reader {
                     array == nullptr ? std::string(TomlTypeName(*node)) : fmt::format("an array of {} items", array->size()));
       return std::nullopt;
     }
-    std::optional<double> x = NumberOf(*array->get(0), key, -limit, limit, "mm");
-    std::optional<double> y = NumberOf(*array->get(1), key, -limit, limit, "mm");
+    const NumberRange range = Closed(-limit, limit, "mm");
+    std::optional<double> x = NumberOf(*array->get(0), key, range);
+    std::optional<double> y = NumberOf(*array->get(1), key, range);
     if (!x || !y) return std::nullopt;
     return Eigen::Vector2d(*x, *y);
+  }
+
+  // The true field's grid over the cell's robot reach at the truth's
+  // correlation length (calibration/truth_spec.h), refused before simulate
+  // starts when it is larger than it may be.
+  void CheckTrueFieldGrid(const toml::table& robot, double correlation_mm) {
+    const double samples = TrueFieldSamples(cell_.robot, correlation_mm);
+    if (samples <= limits::kMaxTrueFieldSamples) return;
+    const cell::Robot& r = cell_.robot;
+    diags_.Report(DiagKind::TruthFieldTooFine, Range(*robot.get("uncalibrated_correlation_mm")),
+                  NumberText(correlation_mm), NumberText(r.limits[0].lo), NumberText(r.limits[0].hi),
+                  NumberText(r.limits[1].lo), NumberText(r.limits[1].hi),
+                  fmt::format("{:.4g}", TrueFieldStepMm(correlation_mm)), fmt::format("{:.3g}", samples),
+                  fmt::format("{:.0f}", limits::kMaxTrueFieldSamples), fmt::format("{:.3g}", MinTrueFieldCorrelationMm(r)));
   }
 
   SourceManager& sources_;

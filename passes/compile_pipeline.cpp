@@ -24,8 +24,13 @@ Result<bool> CompileForCell(std::uint32_t program_file, const std::string& cell_
   if (!cell) return cell.error();
   out.cell = std::move(cell).value();
   if (diags.has_errors() || !out.cell) return false;
+  // The tables' warnings (sign changes, large errors), once per table and
+  // before the findings of the passes: they bear on them, and a long list of
+  // budget findings could otherwise reach the error limit first.
+  cell::ReportTableWarnings(*out.cell, diags);
   out.program.compile = std::make_shared<CompileState>();
   out.program.compile->cell = &*out.cell;
+  out.program.compile->report_budget_findings = out.report_budget_findings;
   std::vector<const PassInfo*> corrections;
   for (const PassInfo& info : CorrectionPassRegistry()) corrections.push_back(&info);
   RunPasses(out.program, diags, corrections, verify_each);

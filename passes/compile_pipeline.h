@@ -21,13 +21,17 @@ namespace smtcal {
 struct CompiledProgram {
   ir::Program program;
   std::optional<cell::Cell> cell;
+  // Set before CompileForCell: CompileState::report_budget_findings.
+  bool report_budget_findings = true;
 };
 
 // Parses and checks the program in `program_file` (loaded into `sources`),
 // loads the cell (even when the program has errors, so both sets of mistakes
 // are reported at once) and runs the correction passes. Returns an Error when
 // the cell file cannot be read; false when errors in the program or the cell
-// kept the correction passes from running; true when they ran. Every
+// kept the correction passes from running; true when they ran. The cell's
+// table warnings (cell::ReportTableWarnings) come before the passes'
+// findings. Every
 // diagnostic, the passes' own included, is left in `diags`.
 // `verify_each` runs the IR verifier after every pass.
 Result<bool> CompileForCell(std::uint32_t program_file, const std::string& cell_path, bool verify_each,

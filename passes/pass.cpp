@@ -1,10 +1,9 @@
 // The pass registry and the pass runner.
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 
 #include <fmt/format.h>
 
+#include "base/check.h"
 #include "ir/symbols.h"
 #include "ir/verifier.h"
 #include "passes/checks/checks.h"
@@ -69,29 +68,24 @@ Result<std::vector<const PassInfo*>> FindPasses(const std::vector<std::string>& 
 
 namespace {
 
-void VerifyOrAbort(const ir::Program& program, const Diagnostics& diags, std::string_view culprit) {
+void VerifyOrFail(const ir::Program& program, const Diagnostics& diags, std::string_view culprit) {
   std::vector<VerifierIssue> issues = VerifyProgram(program);
   // The passes share one symbol table (sema::SymbolsOf): one that changed
   // the declarations must have forgotten it.
   if (program.symbols && !sema::SameSymbols(*program.symbols, sema::SymbolTable::Build(program))) {
-    std::fprintf(stderr,
-                 "smtcal: internal error: the shared symbol table no longer fits the program %s; a pass that "
-                 "changes declarations must call sema::ForgetSymbols. This is a bug in smtcal, not in the program.\n",
-                 std::string(culprit).c_str());
-    std::fflush(stderr);
-    std::abort();
+    InternalError(fmt::format("internal error: the shared symbol table no longer fits the program {}; a pass that "
+                              "changes declarations must call sema::ForgetSymbols. This is a bug in smtcal, not in "
+                              "the program.",
+                              culprit));
   }
   if (issues.empty()) return;
   std::string report = fmt::format(
-      "smtcal: internal error: the IR is broken {} ({} problem{}); this is a bug in smtcal, not "
-      "in the program:\n",
-      culprit, issues.size(), issues.size() == 1 ? "" : "s");
+      "internal error: the IR is broken {} ({} problem{}); this is a bug in smtcal, not in the program:", culprit,
+      issues.size(), issues.size() == 1 ? "" : "s");
   for (const VerifierIssue& issue : issues) {
-    report += fmt::format("  {}\n", FormatVerifierIssue(issue, diags.sources(), program.file));
+    report += fmt::format("\n  {}", FormatVerifierIssue(issue, diags.sources(), program.file));
   }
-  std::fputs(report.c_str(), stderr);
-  std::fflush(stderr);
-  std::abort();
+  InternalError(report);
 }
 
 }  // namespace
@@ -112,11 +106,11 @@ Status RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<std
 
 void RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<const PassInfo*>& passes,
                bool verify_each) {
-  if (verify_each) VerifyOrAbort(program, diags, "in the input to the first pass");
+  if (verify_each) VerifyOrFail(program, diags, "in the input to the first pass");
   for (const PassInfo* info : passes) {
     std::unique_ptr<Pass> pass = info->create();
     pass->Run(program, diags);
-    if (verify_each) VerifyOrAbort(program, diags, fmt::format("after pass '{}'", info->name));
+    if (verify_each) VerifyOrFail(program, diags, fmt::format("after pass '{}'", info->name));
   }
 }
 

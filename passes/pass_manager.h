@@ -23,7 +23,7 @@ Result<std::vector<const PassInfo*>> FindPasses(const std::vector<std::string>& 
 // With verify_each the verifier checks the IR before the first pass (naming
 // the input as the culprit) and after every pass; a broken IR is a bug in
 // smtcal, so it prints every violation, names the pass that caused it and
-// aborts. An unknown pass name is returned as an Error before anything runs.
+// ends as an internal error (base/check.h). An unknown pass name is returned as an Error before anything runs.
 Status RunPasses(ir::Program& program, Diagnostics& diags, const std::vector<std::string>& names,
                  bool verify_each);
 // The same for passes already looked up (or made by a test).

@@ -10,7 +10,17 @@
 // draw of its mean's standard error stddev / sqrt(n) (`derived`), the cell's
 // table as it is (`cell`), a true table file, or nothing (`none`), bilinear
 // between the nodes (a node that states no stddev and count moves by a draw
-// of the robot's repeatability, as the budget assumes). Outside every table
+// of the robot's repeatability, as the budget assumes). `derived` also
+// departs from the bilinear interpolation between the nodes by as much as the
+// region's interpolation estimate E says (cell::Region::interpolation, the
+// budget's figure), per axis table
+//
+//   D(n) = E (cos(theta) sin(pi u) + sin(theta) sin(pi v)) / (|cos(theta)| + |sin(theta)|),
+//
+// u and v the position in grid lines (u = i + s in cell i), theta drawn once
+// per region and axis: smooth, zero at every node, of size E at the cell
+// centres where the two terms agree. So the virtual cell is never kinder
+// between the nodes than verify's estimate. Outside every table
 // domain (TruthOutside): by default a smooth random field G whose largest
 // magnitude over the robot's reach is the robot's uncalibrated accuracy A,
 // with the nearest table's edge value fading into it linearly over the
@@ -62,10 +72,18 @@ class TrueField {
     double phase = 0;
     double weight = 0;
   };
+  // A region's departure from its table's interpolation (derived only).
+  struct Departure {
+    std::array<std::vector<double>, 2> xs, ys;  // per axis table: its grid lines
+    Eigen::Vector2d size_mm = Eigen::Vector2d::Zero();  // E per axis, times interpolation_scale
+    std::array<double, 2> along_x{}, along_y{};          // cos(theta), sin(theta) normalised, per axis
+    Eigen::Vector2d At(const Eigen::Vector2d& n) const;
+  };
   Eigen::Vector2d TableError(const Eigen::Vector2d& n) const;
   Eigen::Vector2d Uncalibrated(const Eigen::Vector2d& n) const;  // G(n)
 
   std::vector<CalibrationMap> maps_;
+  std::vector<Departure> departures_;  // one per map (size 0 where none)
   TruthOutside outside_;
   double fade_mm_;
   double accuracy_mm_ = 0;

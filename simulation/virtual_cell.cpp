@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <optional>
 
 #include "base/check.h"
@@ -32,8 +33,9 @@ std::string_view SimModeDescription(SimMode mode) {
     case SimMode::kNone: return "no correction: commands as written, board at its nominal pose";
     case SimMode::kMeanOffset: return "task origin shifted by the region's table means (the paper's origin shift)";
     case SimMode::kTablesOnly: return "error tables only, no periphery calibration";
-    case SimMode::kPeripheryOnly: return "periphery only: Eq. 4 on raw trips, no tables (the paper's production cell)";
-    case SimMode::kPaper: return "both, as the paper: Eq. 4 on raw trips, tables, Eq. 9 in commanded space";
+    case SimMode::kPeripheryOnly:
+      return "periphery only, as the paper's production cell: raw trips, no scan checks, no tables";
+    case SimMode::kPaper: return "both, as the paper: raw trips, no scan checks, tables, Eq. 9 in commanded space";
     case SimMode::kImproved:
       return "both, improved: direct-calibrated trips, least squares, Eq. 7 in actual space, tables";
   }
@@ -43,6 +45,8 @@ std::string_view SimModeDescription(SimMode mode) {
 bool UsesPeriphery(SimMode mode) {
   return mode == SimMode::kPeripheryOnly || mode == SimMode::kPaper || mode == SimMode::kImproved;
 }
+
+bool UsesCellChecks(SimMode mode) { return mode == SimMode::kImproved; }
 
 long PlannedPlacements(const CompileState& state, const SimOptions& options) {
   long per_round = 0;  // every Cycle statement once
@@ -121,6 +125,22 @@ Eigen::Affine3d DrawBoard(const cell::Fixture& fixture, const BoardPoseModel& mo
     }
   }
   return PlanarFix(fixture.origin_mm + shift, (fixture.angle_deg + rotation_deg) * kRadPerDeg);
+}
+
+// The pose a cell without checks (the paper's) takes from a scan the cell's
+// checks failed: the estimate, whenever there is one. A missing trip leaves
+// an edge without its line and trips that define no pose leave no crossing:
+// those stop the cycle (nullopt). The trip window stops a scan before its
+// estimate, so the estimate is made here.
+std::optional<Eigen::Affine3d> UncheckedPose(const cell::Fixture& fixture, const ScanResult& scan) {
+  const ScanCheck failed = scan.FirstFailure()->check;
+  if (failed == ScanCheck::kMissingTrip || failed == ScanCheck::kDegenerate) return std::nullopt;
+  if (scan.estimate) return scan.estimate->fix;
+  std::vector<Eigen::Vector2d> trips;
+  for (const std::optional<Eigen::Vector2d>& trip : scan.trips) trips.push_back(*trip);
+  const std::optional<FixEstimate> estimate = EstimateFix(fixture, scan.expected, trips, scan.estimator);
+  if (!estimate) return std::nullopt;
+  return estimate->fix;
 }
 
 // Where the robot's real path along the commanded leg (from, to) crosses the
@@ -202,13 +222,17 @@ class Simulator {
       m.by_region.resize(cell_.regions.size());
       result.modes.push_back(m);
     }
-    long planned = 0;
-    for (const CyclePlan& plan : plans_) planned += static_cast<long>(plan.placements.size());
-    planned *= options_.cycles;
+    long per_round = 0;  // the placements of one pass through the Cycle statements
+    for (const CyclePlan& plan : plans_) per_round += static_cast<long>(plan.placements.size());
+    const long planned = per_round * options_.cycles;
     // Every placed part's error is kept: room for all of them at once, so the
     // memory is what PlannedPlacements says, not twice that while a vector grows.
     for (ModeResult& m : result.modes) m.errors_um.reserve(static_cast<std::size_t>(planned));
     scatter_stride_ = std::max<long>(1, planned / std::max<long>(1, static_cast<long>(options_.scatter_points)));
+    // A stride sharing a factor with the placements per round would keep the
+    // same few parts of every cycle (a stride of 200 with 40 parts a round
+    // keeps only the first): the picture must show every part.
+    while (scatter_stride_ > 1 && per_round > 1 && std::gcd(scatter_stride_, per_round) != 1) ++scatter_stride_;
     previous_.assign(kSimModes.size(), std::vector<std::optional<Eigen::Affine3d>>(state_.fixtures.size()));
     record_cycles_.assign(cell_.fixtures.size(), 0);
     for (int n = 0; n < options_.cycles; ++n) {
@@ -280,9 +304,9 @@ class Simulator {
     return p;
   }
 
-  // FIX_0 of the paper's modes: the teach-time trips through Eq. 4, raw. The
-  // estimate is used even when its checks fail (the operator accepted the
-  // teach scan); without one, the compiler's FIX_0.
+  // FIX_0 of the paper's modes: the teach-time trips, raw, through the
+  // fixture's estimator. The estimate is used even when its checks fail (the
+  // operator accepted the teach scan); without one, the compiler's FIX_0.
   void PaperTeachPoses() {
     for (const FixtureBinding& binding : state_.fixtures) {
       std::optional<Eigen::Affine3d> fix0 = binding.fix0;
@@ -291,7 +315,7 @@ class Simulator {
         std::vector<std::optional<Eigen::Vector2d>> trips(fixture.teach_trips_mm.begin(),
                                                           fixture.teach_trips_mm.end());
         ScanOptions scan_options;
-        scan_options.estimator = cell::Estimator::kPaper;
+        scan_options.estimator = fixture.estimator;
         ScanResult scan = ScanFixture(fixture, trips, scan_options);
         if (scan.estimate) fix0 = scan.estimate->fix;
       }
@@ -337,7 +361,11 @@ class Simulator {
   ScanOptions ScanOptionsFor(SimMode mode, const cell::Fixture& fixture, std::size_t mode_index,
                              int fixture_index) const {
     ScanOptions scan_options;
-    scan_options.estimator = mode == SimMode::kImproved ? ImprovedEstimator(&fixture) : cell::Estimator::kPaper;
+    // The paper's modes take the fixture's estimator as the cell declares it:
+    // Eq. 4 where the cell says "paper"; on a layout whose short marker edges
+    // make Eq. 4 useless (the example's) the cell says "rigid", and the
+    // paper's method there is the rigid fit on raw trips.
+    scan_options.estimator = mode == SimMode::kImproved ? ImprovedEstimator(&fixture) : fixture.estimator;
     scan_options.regions = mode == SimMode::kImproved ? &cell_.regions : nullptr;
     scan_options.previous = previous_[mode_index][static_cast<std::size_t>(fixture_index)];
     return scan_options;
@@ -416,13 +444,25 @@ class Simulator {
           long& number = record_cycles_[static_cast<std::size_t>(plan.cell_fixture)];
           result.records.push_back(RecordOfScan(plan.cell_fixture, ++number, clock_s_ + plan.scan_s, scan));
         }
-        if (!scan.ok()) {
-          ++out.faults;
-          out.faults_injected += injected ? 1 : 0;
-          ++out.fault_checks[std::string(ScanCheckName(scan.FirstFailure()->check))];
-          continue;  // the cycle stops: nothing placed
-        }
         fix_n = scan.fix;
+        if (!scan.ok()) {
+          std::string check(ScanCheckName(scan.FirstFailure()->check));
+          if (!UsesCellChecks(mode)) {
+            fix_n = UncheckedPose(*fixture, scan);
+            if (fix_n) {
+              ++out.would_stop;
+              ++out.would_stop_checks[check];
+            } else if (scan.FirstFailure()->check == ScanCheck::kTripWindow) {
+              check = ScanCheckName(ScanCheck::kDegenerate);  // what stopped it here
+            }
+          }
+          if (!fix_n) {
+            ++out.faults;
+            out.faults_injected += injected ? 1 : 0;
+            ++out.fault_checks[check];
+            continue;  // the cycle stops: nothing placed
+          }
+        }
         previous_[m][static_cast<std::size_t>(plan.fixture)] = fix_n;
       }
       for (std::size_t j = 0; j < plan.placements.size(); ++j) {
@@ -458,7 +498,7 @@ class Simulator {
     const double accuracy = (truth_.noise ? truth_.sensor_accuracy_mm.value_or(fixture.sensor_accuracy_mm) : 0.0) +
                             steps * drift.sensor_accuracy_mm_per_cycle;
     const double threshold_mm = steps * drift.sensor_threshold_mm_per_cycle;
-    const double latency_mm = fixture.scan_speed_mm_s * servo_period_s_;
+    const double latency_mm = fixture.TripLatchSpeedMmS() * servo_period_s_;
     const std::vector<ExpectedTrip>& expected = ExpectedFor(fixture);
     std::vector<std::optional<Eigen::Vector2d>> trips;
     std::vector<std::size_t> on_path(fixture.scan_paths.size(), 0);
@@ -533,6 +573,7 @@ SimResult Simulate(const CompileState& state, const TruthSpec& truth, const SimO
       std::string(cell::EstimatorName(first != nullptr && first->estimator != cell::Estimator::kPaper
                                           ? first->estimator
                                           : cell::Estimator::kRigid));
+  result.paper_estimator = first != nullptr ? std::string(cell::EstimatorName(first->estimator)) : "";
   return result;
 }
 

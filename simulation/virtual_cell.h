@@ -10,7 +10,9 @@
 //          the true marker edge, +- the sensor's accuracy, latched up to one
 //          servo period late (a uniform draw); none if it does not cross
 //   modes: each turns the same trips (periphery modes) and the compiled
-//          targets into commands; a failed scan check stops the cycle
+//          targets into commands; a failed scan check stops the cycle (in
+//          the paper's modes only a missing trip or no pose: the paper's
+//          cell had no checks; what the others would have stopped is counted)
 //   place: the robot lands at F_true(command) + repeatability; the error is
 //          the distance to where the part truly belongs (FIX_true . f)
 // The cycle's trace is the compiler's (CompileState::cycle_traces): branches
@@ -37,8 +39,8 @@ enum class SimMode : int {
   kNone = 0,       // commands as written: nominal board pose, no tables
   kMeanOffset,     // the task origin shifted by the region's table means (the paper's first step)
   kTablesOnly,     // F^-1 through the tables at the nominal board pose (no periphery calibration)
-  kPeripheryOnly,  // the paper's production cell: Eq. 4 on raw trips, no tables
-  kPaper,          // the paper: Eq. 4 on raw trips + tables, taught points by Eq. 9 in commanded space
+  kPeripheryOnly,  // the paper's production cell: the fixture's estimator on raw trips, no checks, no tables
+  kPaper,          // the paper: the same scan + tables, taught points by Eq. 9 in commanded space
   kImproved,       // ours: direct-calibrated trips, least squares, Eq. 7 in actual space + tables
 };
 inline constexpr std::array<SimMode, 6> kSimModes = {SimMode::kNone,          SimMode::kMeanOffset,
@@ -47,6 +49,12 @@ inline constexpr std::array<SimMode, 6> kSimModes = {SimMode::kNone,          Si
 std::string_view SimModeName(SimMode mode);         // none, mean-offset, tables, periphery, paper, improved
 std::string_view SimModeDescription(SimMode mode);  // one line for reports
 bool UsesPeriphery(SimMode mode);
+// Whether a mode's cycles stop on every failed scan check of the cell
+// (improved, as the compiled program does), or run as the paper's cell did,
+// which had no checks (periphery, paper): only a missing trip or trips that
+// define no pose (no line to fit, no crossing) stop its cycle; the cell's
+// other checks are still evaluated and counted (ModeResult::would_stop).
+bool UsesCellChecks(SimMode mode);
 
 struct SimOptions {
   int cycles = 1000;        // executions of each Cycle statement
@@ -67,6 +75,11 @@ struct ModeResult {
   int cycles = 0;             // cycles started
   int faults = 0;             // cycles stopped by a failed scan check
   std::map<std::string, int> fault_checks;  // by check name
+  // Modes without the cell's checks (UsesCellChecks false): the cycles they
+  // ran although the cell's checks would have stopped them, by the first
+  // check that fails.
+  int would_stop = 0;
+  std::map<std::string, int> would_stop_checks;
   long placements = 0;        // parts placed
   long within = 0;            // within their region's tolerance
   int faults_injected = 0;      // stopped cycles among those with an injected fault
@@ -89,6 +102,7 @@ struct SimResult {
   int unknown_targets = 0;       // placements depending on run-time values: not simulated
   double tolerance_mm = 0;       // the smallest tolerance of a placement's region
   std::string fixture_estimator; // the improved mode's estimator
+  std::string paper_estimator;    // the paper's modes': the first fixture's, as the cell declares it
   double uncalibrated_accuracy_mm = 0;  // the true field's size outside the tables
   bool accuracy_assumed = false;        // not declared: kAssumedUncalibratedAccuracyMm
   std::vector<std::string> regions;     // the cell's region names, for by_region

@@ -3,13 +3,21 @@
 // it describes (text, or JSON with --json). The loading and all the checks
 // are in frontend/cell_toml.cpp; this file only wires the file, the options,
 // the summary and the exit codes.
+#include <filesystem>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "backend/reports/table_report.h"
+#include "backend/reports/cell_plot.h"
+#include "base/field_text.h"
 #include "base/json_text.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/scan_plan.h"
 #include "frontend/cell_toml.h"
+#include "passes/correction/compile_state.h"
 #include "tools/commands.h"
+#include "tools/compile_pipeline.h"
 
 namespace smtcal::tools {
 namespace {
@@ -59,6 +67,7 @@ std::string SummaryText(const cell::Cell& cell) {
                        region.name, Range(region.x_mm), Range(region.y_mm), region.table_path, Num(region.domain.x0),
                        Num(region.domain.x1), Num(region.domain.y0), Num(region.domain.y1), region.difficulty_level,
                        Axes(region), Num(region.tolerance_mm), cell::OutsidePolicyName(region.outside));
+    out += fmt::format("    between the nodes: {}\n", InterpolationText(region.interpolation, region.tolerance_mm));
   }
 
   out += fmt::format("fixtures: {}\n", cell.fixtures.size());
@@ -71,6 +80,15 @@ std::string SummaryText(const cell::Cell& cell) {
                        fixture.name, Num(fixture.origin_mm.x()), Num(fixture.origin_mm.y()), Num(fixture.angle_deg),
                        Num(fixture.l1_mm), Num(fixture.l2_mm), fixture.scan_paths.size(),
                        ExpectedTrips(fixture).size(), cell::EstimatorName(fixture.estimator), teach);
+    const CaptureRange capture = ScanCaptureRange(fixture);
+    out += fmt::format("    scan: {}; capture range {} mm and {} deg, {} x the limits ({} mm, {} deg){}\n",
+                       fixture.latch_speed_mm_s > 0
+                           ? fmt::format("two stages, search {} mm/s, latch {} mm/s", Num(fixture.scan_speed_mm_s),
+                                         Num(fixture.latch_speed_mm_s))
+                           : fmt::format("one stage at {} mm/s", Num(fixture.scan_speed_mm_s)),
+                       fmt::format("{:.2f}", capture.shift_mm), fmt::format("{:.3f}", capture.rotation_deg),
+                       fmt::format("{:.2f}", capture.factor), Num(fixture.max_shift_mm), Num(fixture.max_rotation_deg),
+                       capture.factor >= 1 ? "" : ": smaller than the limits");
   }
 
   out += fmt::format("feeders: {}\n", cell.feeders.size());
@@ -82,6 +100,14 @@ std::string SummaryText(const cell::Cell& cell) {
     }
     if (!feeder.packages.empty()) line += fmt::format("; package {}", Join(feeder.packages, ", "));
     if (!feeder.value.empty()) line += fmt::format("; value {}", feeder.value);
+    const int points = feeder.columns * feeder.rows;
+    if (feeder.kind == cell::FeederKind::kTray) {
+      line += fmt::format("; a tray of {} pockets, one part each", points);
+    } else if (feeder.pallet_last && points > 1) {
+      line += static_cast<int>(feeder.packages.size()) == points
+                  ? fmt::format("; a bank of {} tapes, lane k holds the k-th package", points)
+                  : fmt::format("; a bank of {} tapes, each kind of part takes the next free lane", points);
+    }
     out += line + "\n";
   }
   return out;
@@ -89,6 +115,16 @@ std::string SummaryText(const cell::Cell& cell) {
 
 ordered_json Pair(double a, double b) { return ordered_json::array({a, b}); }
 ordered_json Pair(const cell::Interval& interval) { return Pair(interval.lo, interval.hi); }
+
+ordered_json CaptureJson(const CaptureRange& capture, const cell::Fixture& fixture) {
+  return {{"factor", RoundedToDecimals(capture.factor, 4)},
+          {"shift_mm", RoundedToDecimals(capture.shift_mm, 4)},
+          {"rotation_deg", RoundedToDecimals(capture.rotation_deg, 5)},
+          {"covers_limits", capture.factor >= 1},
+          {"limited_by", capture.limited_by.empty() ? ordered_json() : ordered_json(capture.limited_by)},
+          {"max_shift_mm", fixture.max_shift_mm},
+          {"max_rotation_deg", fixture.max_rotation_deg}};
+}
 
 std::string SummaryJson(const cell::Cell& cell) {
   ordered_json out;
@@ -123,7 +159,8 @@ std::string SummaryJson(const cell::Cell& cell) {
                      {"y_mm", Pair(region.domain.y0, region.domain.y1)}}},
          {"difficulty", {{"level", region.difficulty_level}, {"axes", axes}}},
          {"tolerance_mm", region.tolerance_mm},
-         {"outside", cell::OutsidePolicyName(region.outside)}});
+         {"outside", cell::OutsidePolicyName(region.outside)},
+         {"interpolation", InterpolationJson(region.interpolation, region.tolerance_mm)}});
   }
   out["fixtures"] = ordered_json::array();
   for (const cell::Fixture& fixture : cell.fixtures) {
@@ -139,7 +176,10 @@ std::string SummaryJson(const cell::Cell& cell) {
          {"trips", ExpectedTrips(fixture).size()},
          {"estimator", cell::EstimatorName(fixture.estimator)},
          {"teach_scan", !fixture.teach_trips_mm.empty()},
-         {"teach_trips", fixture.teach_trips_mm.size()}});
+         {"teach_trips", fixture.teach_trips_mm.size()},
+         {"scan_speed_mm_s", fixture.scan_speed_mm_s},
+         {"latch_speed_mm_s", fixture.latch_speed_mm_s > 0 ? ordered_json(fixture.latch_speed_mm_s) : ordered_json()},
+         {"capture", CaptureJson(ScanCaptureRange(fixture), fixture)}});
   }
   out["feeders"] = ordered_json::array();
   for (const cell::Feeder& feeder : cell.feeders) {
@@ -165,12 +205,63 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
     options.exit_code = ReportIoError(loaded.error());
     return;
   }
-  if (loaded.value()) cell::CheckScanCalibration(*loaded.value(), diags);
+  if (loaded.value()) {
+    cell::CheckScanCalibration(*loaded.value(), diags);
+    cell::ReportTableWarnings(*loaded.value(), diags);
+    cell::ReportGridAdvice(*loaded.value(), diags);
+  }
   options.exit_code = PrintDiagnostics(diags, options);
   if (!loaded.value()) return;  // the errors were printed
   const cell::Cell& cell = *loaded.value();
   Status written = WriteFileAtomically("-", json ? SummaryJson(cell) : SummaryText(cell));
   if (!written) options.exit_code = ReportIoError(written.error());
+}
+
+// `smtcal cell plot CELL.toml -o FILE.svg [--program P.place]`: the cell as
+// a picture (backend/reports/cell_plot.h); with a program, its placements
+// where the correction passes put them at the fixtures' nominal poses.
+void RunPlot(const std::string& path, const std::string& output, const std::string& program_path,
+             GlobalOptions& options) {
+  if (FilesClash({{"CELL", path}, {"--program", program_path}}, {{"-o", output}})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::vector<PlottedTarget> targets;
+  std::optional<cell::Cell> cell;
+  if (program_path.empty()) {
+    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, sources, diags);
+    if (!loaded) {
+      options.exit_code = ReportIoError(loaded.error());
+      return;
+    }
+    cell = std::move(loaded).value();
+  } else {
+    CompiledProgram compiled;
+    if (!CompileForCell(program_path, path, false, sources, diags, compiled, options)) return;
+    cell = std::move(compiled.cell);
+    if (compiled.program.compile != nullptr) {
+      for (const Target& target : compiled.program.compile->targets) {
+        if (!target.known) continue;
+        targets.push_back({target.text, target.required[0], target.required[1], target.is_placement(),
+                           target.fixture});
+      }
+    }
+  }
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (!cell || options.exit_code != kExitOk) {
+    if (options.exit_code == kExitOk) options.exit_code = kExitInputError;
+    return;
+  }
+  const std::string title = std::filesystem::path(path).filename().string();
+  const std::string program = program_path.empty() ? "" : std::filesystem::path(program_path).filename().string();
+  Status written = WriteFileAtomically(output, PlotCellSvg(*cell, title, program, targets));
+  if (!written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  SayDone(options, output, fmt::format("wrote the picture {}", output));
 }
 
 }  // namespace
@@ -179,17 +270,29 @@ void AddCellCommand(CLI::App& app, GlobalOptions& options) {
   static std::string path;
   static bool json = false;
   CLI::App* cell = app.add_subcommand(
-      "cell", "Check cell files (*.cell.toml): robot, calibrated regions, fixtures, feeders (docs/cell.md)");
+      "cell", "Check and draw cell files (*.cell.toml): robot, calibrated regions, fixtures, feeders (docs/cell.md)");
   cell->require_subcommand(1);
   CLI::App* check = cell->add_subcommand(
       "check", "Load a cell file and its error tables, report every mistake (exit 1), and print a summary:\n"
-               "the robot, each region (bounds, table domain, difficulty, tolerance, policy), each fixture\n"
+               "the robot, each region (bounds, table domain, difficulty, tolerance, policy, the interpolation\n"
+               "error between its table's nodes and the pitch to measure at when it is more than 10 % of the\n"
+               "tolerance), each fixture\n"
                "(pose, L1/L2, scan trips, estimator, teach scan) and each feeder");
   check->add_option("CELL", path,
                     "the cell file ('-' for stdin; its table paths are then relative to the current directory)")
       ->required();
   check->add_flag("--json", json, "print the summary as JSON instead of text");
   check->callback([&options] { RunCheck(path, json, options); });
+
+  static std::string plot_path, plot_output, plot_program;
+  CLI::App* plot = cell->add_subcommand(
+      "plot", "Draw the cell as an SVG picture: the robot's travel, the regions with their tables' extent,\n"
+              "the fixtures with markers, scan paths and nominal trips, the feeders with their lanes and\n"
+              "pockets, and with --program the program's placements (docs/cell.md)");
+  plot->add_option("CELL", plot_path, "the cell file")->required();
+  plot->add_option("-o,--output", plot_output, "the SVG file to write ('-' for stdout)")->required();
+  plot->add_option("--program", plot_program, "a .place program whose placements to draw on the fixtures");
+  plot->callback([&options] { RunPlot(plot_path, plot_output, plot_program, options); });
 }
 
 }  // namespace smtcal::tools

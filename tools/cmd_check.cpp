@@ -38,18 +38,13 @@ void AddCheckCommand(CLI::App& app, GlobalOptions& options) {
     if (!diags.has_errors()) {
       Status ran = RunPasses(program, diags, passes, verify_each);
       if (!ran) {  // not expected: --passes was validated while parsing the command line
-        fmt::print(stderr, "smtcal: error: {}\n", ran.error().message);
-        options.exit_code = kExitUsageError;
+        options.exit_code = ReportUsageError(ran.error().message);
         return;
       }
     }
     options.exit_code = PrintDiagnostics(diags, options);
     if (options.exit_code == kExitOk) {
-      const std::size_t warnings = diags.warning_count();
-      SayDone(options, "", fmt::format("{}: no errors, {}", sources.File(file.value()).name,
-                                       warnings == 0   ? std::string("no warnings")
-                                       : warnings == 1 ? std::string("1 warning")
-                                                       : fmt::format("{} warnings", warnings)));
+      SayDone(options, "", NoErrorsText(sources.File(file.value()).name, diags.warning_count()));
     }
   });
 }

@@ -7,6 +7,8 @@
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_dry_run.h"
 #include "backend/linuxcnc/linuxcnc_emit.h"
+#include "backend/linuxcnc/linuxcnc_machine.h"
+#include "frontend/linuxcnc_config.h"
 #include "backend/place/place_printer.h"
 #include "backend/reports/compile_report.h"
 #include "calibration/cell.h"
@@ -30,6 +32,7 @@ struct CompileOptions {
   bool json = false;
   bool verify_each = false;
   bool dry_run_probe = false;  // --target linuxcnc: also OUT/dry-run/smtcal_probe_trips.ngc
+  std::string ini;             // --target linuxcnc: the machine's INI, checked; the runtime goes where it says
 };
 
 
@@ -46,6 +49,8 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
       " XY(...) in Pick/Place/Jump/Go/Move are robot commands (nominal coordinates) with the required",
       " position in the comment; points in fixture frames are corrected on the controller after each Scan.",
   };
+  // The cell and table files it was compiled with: `smtcal diff` finds and checks them by these.
+  for (const cell::CellFile& file : cell.files) lines.push_back(" " + cell::CellFileLine(file));
   ir::Block header;
   for (const std::string& line : lines) {
     auto stmt = std::make_unique<ir::Stmt>();
@@ -58,8 +63,8 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
 }
 
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("-o", opt.output, {opt.program_path, opt.cell_path}) ||
-      OutputOverwritesInput("--report", opt.report, {opt.program_path, opt.cell_path, opt.output})) {
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}, {"--ini", opt.ini}},
+                 {{"-o", opt.output, opt.target == "linuxcnc"}, {"--report", opt.report}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -75,11 +80,33 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   std::unique_ptr<LinuxCncDirectory> directory;
   TextOutput review;  // -o -, or where the text goes when the directory cannot be written
   Status opened = Ok{};
+  // The machine's INI and HAL files (--ini): checked against the cell and
+  // the program below; the runtime goes to the folder its SUBROUTINE_PATH names.
+  std::optional<IniFile> ini;
+  HalConfig hal;
+  std::filesystem::path runtime_folder;
+  if (opt.target == "linuxcnc" && !opt.ini.empty() && !diags.has_errors()) {
+    Result<IniFile> read = ReadLinuxCncIni(opt.ini, sources, diags);
+    if (!read) {
+      options.exit_code = PrintDiagnostics(diags, options);
+      options.exit_code = ReportIoError(read.error());
+      return;
+    }
+    ini = std::move(read).value();
+    hal = ReadLinuxCncHal(*ini, sources, diags);
+    Result<std::filesystem::path> folder = LinuxCncRuntimeFolder(*ini);
+    if (folder) {
+      runtime_folder = folder.value();
+    } else {
+      diags.Report(DiagKind::LinuxCncSubroutinePath, ini->range,
+                   "name the folder smtcal writes its runtime into (e.g. SUBROUTINE_PATH = smtcal-runtime)");
+    }
+  }
   if (opt.target == "linuxcnc" && !diags.has_errors()) {
     TextOutput* main = &review;
     if (opt.output != "-") {
       Result<std::unique_ptr<LinuxCncDirectory>> open =
-          LinuxCncDirectory::Open(opt.output, LinuxCncMainName(opt.program_path));
+          LinuxCncDirectory::Open(opt.output, LinuxCncMainName(opt.program_path), runtime_folder);
       if (open) {
         directory = std::move(open).value();
         main = &directory->main();
@@ -91,6 +118,7 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
     if (linuxcnc && opt.dry_run_probe) {
       linuxcnc->dry_run.push_back({kLinuxCncDryRunFile, EmitLinuxCncDryRunProbe(*compiled.cell)});
     }
+    if (linuxcnc && ini) CheckLinuxCncMachine(*compiled.cell, linuxcnc->io, *ini, hal, sources, diags);
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;  // nothing half-written
@@ -98,9 +126,10 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   if (opt.target == "c") {
     for (const cell::Fixture& fixture : compiled.cell->fixtures) {
       if (FitsCRuntime(fixture)) continue;
-      fmt::print(stderr, "smtcal: error: the scan paths of fixture '{}' make more trips than the C runtime holds ({}, "
-                         "SMTCAL_MAX_TRIPS in runtime/c/smtcal_runtime.h)\n", fixture.name, kCRuntimeMaxTrips);
-      options.exit_code = kExitInputError;
+      options.exit_code = ReportInputError(
+          fmt::format("the scan paths of fixture '{}' make more trips than the C runtime holds ({}, "
+                      "SMTCAL_MAX_TRIPS in runtime/c/smtcal_runtime.h)",
+                      fixture.name, kCRuntimeMaxTrips));
       return;
     }
     text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ir::ProgramName(compiled.program));
@@ -119,10 +148,16 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
     }
     report.emplace(std::move(staged).value());
   }
+  // Without the machine's INI: a machine for the cell beside the program.
+  std::vector<LinuxCncMachineFile> machine;
+  if (linuxcnc && !ini) {
+    machine = EmitLinuxCncMachine(*compiled.cell, linuxcnc->io,
+                                  std::filesystem::path(linuxcnc->main_name).stem().string());
+  }
   Status written = opt.target == "c"       ? WriteFileAtomically(opt.output, text)
                    : opt.target == "place" ? WritePlace(opt.output, compiled.program)
                    : !opened               ? opened
-                   : directory             ? directory->Commit(*linuxcnc)
+                   : directory             ? directory->Commit(*linuxcnc, machine)
                                            : WriteFileAtomically("-", LinuxCncReviewText(*linuxcnc, review.text()));
   if (written && report) written = report->Commit();
   if (!written) {
@@ -131,13 +166,20 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   }
   const std::string what = opt.target == "c"       ? "the C runtime's data"
                            : opt.target == "place" ? "the corrected program"
-                                                   : "the LinuxCNC program and its subroutines";
+                           : ini                   ? fmt::format("the LinuxCNC program; its runtime in {}, checked "
+                                                                 "against {}",
+                                                                 runtime_folder.string(), opt.ini)
+                                                   : "the LinuxCNC program, its subroutines and a machine for it";
   SayDone(options, opt.output,
           fmt::format("wrote {} ({} for cell '{}', {} targets){}", opt.output, what, compiled.cell->name,
                       state.targets.size(), opt.report.empty() ? std::string() : " and the report " + opt.report));
 }
 
 void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}}, {})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
@@ -180,13 +222,22 @@ void AddCompileCommand(CLI::App& app, GlobalOptions& options) {
                     "with --target linuxcnc: also write OUT/dry-run/smtcal_probe_trips.ngc, the nominal trips of "
                     "the nominal board instead of the marker scan, for rs274 only (put OUT/dry-run first on its "
                     "subroutine path; examples/linuxcnc/README.md)");
+  compile->add_option("--ini", compile_options.ini,
+                      "with --target linuxcnc: the machine's LinuxCNC INI; it and its HAL files are checked against "
+                      "the cell and the program (limits, speeds, servo period, signals), and the runtime goes to the "
+                      "folder its SUBROUTINE_PATH names, shared by every program for that machine (-o then gets "
+                      "the main program only). Without it, -o also gets a machine for the cell (PROGRAM.ini, "
+                      ".hal, .tbl, .var)");
   compile->add_option("--report", compile_options.report,
                       "also write a JSON report of every motion target (required and nominal position, correction, "
                       "region, residual, budget) and the cycle-time estimate");
   compile->callback([&options] {
     if (compile_options.dry_run_probe && compile_options.target != "linuxcnc") {
-      fmt::print(stderr, "smtcal: error: --dry-run-probe needs --target linuxcnc\n");
-      options.exit_code = kExitUsageError;
+      options.exit_code = ReportUsageError("--dry-run-probe needs --target linuxcnc");
+      return;
+    }
+    if (!compile_options.ini.empty() && compile_options.target != "linuxcnc") {
+      options.exit_code = ReportUsageError("--ini needs --target linuxcnc");
       return;
     }
     RunCompile(compile_options, options);

@@ -264,6 +264,10 @@ void ReportFailure(const ScanResult& result, const cell::Fixture& fixture, const
 }
 
 void Run(const FixtureOptions& opt, GlobalOptions& options) {
+  if (FilesClash({{"--cell", opt.cell}, {"--trips", opt.trips}, {"--previous", opt.previous}}, {})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
   SourceManager sources;
   Diagnostics diags(sources);
   Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
@@ -280,9 +284,8 @@ void Run(const FixtureOptions& opt, GlobalOptions& options) {
   if (fixture == nullptr) {
     std::string names;
     for (const cell::Fixture& f : cell.fixtures) names += (names.empty() ? "" : ", ") + f.name;
-    fmt::print(stderr, "smtcal: error: the cell {} has no fixture '{}'; {}\n", opt.cell, opt.fixture,
-               names.empty() ? "it describes none" : "its fixtures: " + names);
-    options.exit_code = kExitUsageError;
+    options.exit_code = ReportUsageError(fmt::format("the cell {} has no fixture '{}'; {}", opt.cell, opt.fixture,
+                                                     names.empty() ? "it describes none" : "its fixtures: " + names));
     return;
   }
   Result<std::uint32_t> trips_file = sources.Load(opt.trips);

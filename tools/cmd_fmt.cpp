@@ -21,7 +21,7 @@ int RunFmt(const FmtOptions& fmt_options, const GlobalOptions& options) {
   if (fmt_options.in_place && fmt_options.path == "-") {
     throw CLI::ValidationError("--in-place", "standard input cannot be rewritten in place; use -o OUT");
   }
-  if (OutputOverwritesInput("-o", fmt_options.output, {fmt_options.path})) return kExitUsageError;
+  if (FilesClash({{"FILE", fmt_options.path}}, {{"-o", fmt_options.output}})) return kExitUsageError;
   SourceManager sources;
   Result<std::uint32_t> file = sources.Load(fmt_options.path);
   if (!file) return ReportIoError(file.error());

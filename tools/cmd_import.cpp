@@ -13,6 +13,9 @@
 #include <fmt/core.h>
 
 #include "backend/place/place_printer.h"
+#include "backend/reports/import_report.h"
+#include "backend/reports/setup_sheet.h"
+#include "base/field_text.h"
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_reader.h"
@@ -22,6 +25,7 @@
 #include "frontend/feeders_toml.h"
 #include "frontend/input_kind.h"
 #include "tools/commands.h"
+#include "tools/feeders_option.h"
 
 namespace smtcal::tools {
 namespace {
@@ -40,7 +44,11 @@ struct ImportCliOptions {
   std::string bottom_positions;
   std::string bottom_rotation = "top-view";
   std::string angles = "signed";
-  std::string origin;  // empty: centred on the fixture's largest calibrated region (BoardSpot)
+  std::string origin;  // empty: in the fixture's pocket, else centred on its largest calibrated region (BoardSpot)
+  std::string board;   // --board W,H or X,Y,W,H: the outline in the list's coordinates
+  std::string report;       // --report FILE.json
+  std::string setup_sheet;  // --setup-sheet FILE: the feeder set-up sheet as text
+  std::string setup_csv;    // --setup-csv FILE: the same as CSV
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
@@ -72,44 +80,69 @@ std::string BaseName(const std::string& path) {
   return path == "-" ? "<stdin>" : std::filesystem::path(path).filename().string();
 }
 
-// "X,Y" -> two finite lengths within kMaxLengthMm.
-std::optional<std::array<double, 2>> ParsePair(const std::string& text) {
+// "X,Y" -> two positions in mm (limits::kPositionMm), or why not. Each
+// number goes through the one check of base/number_range.h.
+Result<std::array<double, 2>> ParsePair(const std::string& text) {
   std::size_t comma = text.find(',');
-  if (comma == std::string::npos) return std::nullopt;
-  std::optional<double> a = ParseNumber(text.substr(0, comma));
-  std::optional<double> b = ParseNumber(text.substr(comma + 1));
-  if (!a || !b || !std::isfinite(*a) || !std::isfinite(*b) || std::abs(*a) > kMaxLengthMm ||
-      std::abs(*b) > kMaxLengthMm) {
-    return std::nullopt;
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos) {
+    return Error{"expected X,Y in mm: two numbers with a comma between them and no space, e.g. 10.5,20 or -5,10"};
   }
-  return std::array<double, 2>{*a, *b};
+  Result<double> a = ParseNumberIn(std::string_view(text).substr(0, comma), limits::kPositionMm);
+  if (!a) return Error{"X: " + a.error().message};
+  Result<double> b = ParseNumberIn(std::string_view(text).substr(comma + 1), limits::kPositionMm);
+  if (!b) return Error{"Y: " + b.error().message};
+  return std::array<double, 2>{a.value(), b.value()};
 }
 
 CLI::Validator PairValidator() {
   return CLI::Validator(
       [](const std::string& text) -> std::string {
-        return ParsePair(text) ? std::string() : "expected X,Y in mm: two numbers with a comma between them and no "
-                                                 "space, e.g. 10.5,20 or -5,10";
+        Result<std::array<double, 2>> pair = ParsePair(text);
+        return pair ? std::string() : pair.error().message;
       },
-      "X,Y");
+      "");
 }
 
-// "CxR" -> columns and rows of a panel.
-std::optional<std::array<int, 2>> ParsePanel(const std::string& text) {
-  std::size_t x = text.find_first_of("xX");
-  if (x == std::string::npos) return std::nullopt;
-  try {
-    std::size_t used = 0;
-    int columns = std::stoi(text.substr(0, x), &used);
-    if (used != x) return std::nullopt;
-    int rows = std::stoi(text.substr(x + 1), &used);
-    if (used != text.size() - x - 1 || columns < 1 || rows < 1 || columns * static_cast<long>(rows) > 10000) {
-      return std::nullopt;
-    }
-    return std::array<int, 2>{columns, rows};
-  } catch (const std::exception&) {
-    return std::nullopt;
+// "W,H" or "X,Y,W,H" -> the outline x0, y0, x1, y1, or why not. X and Y
+// are positions (limits::kPositionMm), W and H lengths (limits::kLengthMm),
+// each through the one check of base/number_range.h.
+Result<std::array<double, 4>> ParseBoard(const std::string& text) {
+  std::vector<std::string_view> parts;
+  std::string_view rest(text);
+  for (;;) {
+    const std::size_t comma = rest.find(',');
+    parts.push_back(rest.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 1);
   }
+  if (parts.size() != 2 && parts.size() != 4) {
+    return Error{"expected W,H or X,Y,W,H in mm with no spaces, e.g. 16.6,40.1 or -5,0,50,30"};
+  }
+  const char* names[] = {"X", "Y", "W", "H"};
+  std::array<double, 4> numbers{0, 0, 0, 0};
+  const std::size_t first = 4 - parts.size();
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::size_t slot = first + k;
+    Result<double> number = ParseNumberIn(parts[k], slot < 2 ? limits::kPositionMm : limits::kLengthMm);
+    if (!number) return Error{fmt::format("{}: {}", names[slot], number.error().message)};
+    numbers[slot] = number.value();
+  }
+  return std::array<double, 4>{numbers[0], numbers[1], numbers[0] + numbers[2], numbers[1] + numbers[3]};
+}
+
+// "CxR" -> columns and rows of a panel, or why not.
+Result<std::array<int, 2>> ParsePanel(const std::string& text) {
+  std::size_t x = text.find_first_of("xX");
+  if (x == std::string::npos) return Error{"expected CxR, e.g. 3x2"};
+  Result<WholeNumber> columns = ParseWholeNumberIn(std::string_view(text).substr(0, x), limits::kPalletCount);
+  if (!columns) return Error{"C: " + columns.error().message};
+  Result<WholeNumber> rows = ParseWholeNumberIn(std::string_view(text).substr(x + 1), limits::kPalletCount);
+  if (!rows) return Error{"R: " + rows.error().message};
+  const long boards = static_cast<long>(columns.value().magnitude * rows.value().magnitude);
+  if (boards > limits::kMaxPanelBoards) {
+    return Error{fmt::format("{} boards; a panel has at most {}", boards, limits::kMaxPanelBoards)};
+  }
+  return std::array<int, 2>{static_cast<int>(columns.value().magnitude), static_cast<int>(rows.value().magnitude)};
 }
 
 std::optional<char> ParseDelimiter(const std::string& text) {
@@ -211,10 +244,17 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
   if (opt.bottom_positions == "negated-x") import.bottom_positions = cad::BottomPositions::kNegatedX;
   import.bottom_rotation = opt.bottom_rotation == "bottom-view" ? BottomRotation::kBottomView : BottomRotation::kTopView;
   import.angles = opt.angles == "positive" ? AngleRange::kPositive : AngleRange::kSigned;
-  std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : *ParsePair(opt.origin);
-  std::array<double, 2> pitch = *ParsePair(opt.pitch);
+  std::array<double, 2> origin = opt.origin.empty() ? std::array<double, 2>{0, 0} : ParsePair(opt.origin).value();
+  if (!opt.board.empty()) import.board = ParseBoard(opt.board).value();
+  if (fixture.pocket_mm) {
+    const auto& [x, y] = *fixture.pocket_mm;
+    import.pocket = std::array<double, 4>{x.lo, y.lo, x.hi, y.hi};
+    import.pocket_range = fixture.pocket_range;
+  }
+  import.keep_fates = !opt.report.empty();
+  std::array<double, 2> pitch = ParsePair(opt.pitch).value();
   import.origin_given = !opt.origin.empty();
-  std::array<int, 2> panel = *ParsePanel(opt.panel);
+  std::array<int, 2> panel = ParsePanel(opt.panel).value();
   import.origin_x_mm = origin[0];
   import.origin_y_mm = origin[1];
   import.rotation_deg = opt.rotation_deg;
@@ -241,9 +281,11 @@ ImportOptions MakeImportOptions(const ImportCliOptions& opt, const cell::Fixture
 
 void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   cad::ReadOptions read = MakeReadOptions(opt);  // usage errors first, before any file is read
-  std::vector<std::string> inputs = {opt.list, opt.cell};
-  if (!opt.feeders.empty()) inputs.push_back(opt.feeders);
-  if (OutputOverwritesInput("-o", opt.output, inputs)) {
+  if (FilesClash({{"LIST", opt.list}, {"--cell", opt.cell}, {"--feeders", opt.feeders}},
+                 {{"-o", opt.output},
+                  {"--report", opt.report},
+                  {"--setup-sheet", opt.setup_sheet},
+                  {"--setup-csv", opt.setup_csv}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -258,15 +300,7 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::optional<cell::Cell> cell = std::move(loaded).value();
   const cell::Fixture* fixture = cell ? ChooseFixture(*cell, opt.fixture, diags) : nullptr;
   cad::FeedersFile feeders_file;
-  if (!opt.feeders.empty()) {
-    Result<std::optional<cad::FeedersFile>> file = cad::LoadFeeders(opt.feeders, sources, diags);
-    if (!file) {
-      PrintDiagnostics(diags, options);
-      options.exit_code = ReportIoError(file.error());
-      return;
-    }
-    if (file.value()) feeders_file = std::move(*file.value());
-  }
+  if (!LoadFeedersOption(opt.feeders, sources, diags, feeders_file, options)) return;
   if (fixture != nullptr && !opt.place_z_mm && !fixture->place_z_mm) {
     diags.Report(DiagKind::ImportNoPlaceZ, fixture->name_range, fixture->name);
   }
@@ -299,8 +333,6 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     import.centre_spot = spot->first;
     import.centre_spot_name = spot->second;
   }
-  const bool origin_given = import.origin_given;
-  const std::string spot_name = import.centre_spot ? import.centre_spot_name : std::string();
   const std::string place_z_source =
       opt.place_z_mm ? std::string("--place-z") : fmt::format("place_z_mm of fixture {}", fixture->name);
   const double place_z = import.place_z_mm;
@@ -320,31 +352,34 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   std::string summary = FormatImportSummary(importer.summary());
   if (program) {
     const ImportSummary& s = importer.summary();
-    summary += fmt::format("  board:   origin ({}, {}) mm in fixture {}{}\n  place:   at z = {} mm ({})\n",
-                           s.origin_x_mm, s.origin_y_mm, fixture->name,
-                           origin_given       ? " (--origin)"
-                           : spot_name.empty() ? fmt::format(": the fixture carries no calibrated region to centre the "
-                                                             "parts on; give --origin X,Y")
-                                               : fmt::format(", the parts centred on {} (--origin X,Y to place the "
-                                                             "board elsewhere)",
-                                                             spot_name),
-                           place_z, place_z_source);
+    summary += fmt::format("  board:   outline {}\n           origin ({}, {}) mm in fixture {}: {}\n"
+                           "  place:   at z = {} mm ({})\n",
+                           s.outline, s.origin_x_mm, s.origin_y_mm, fixture->name, s.origin_how, place_z,
+                           place_z_source);
   }
   if (options.exit_code != kExitOk || !program) {
-    std::fputs(summary.c_str(), stderr);
+    SaySummary(summary);
     options.exit_code = kExitInputError;
     return;  // nothing half-written
   }
-  Status written = WriteFileAtomically(opt.output, PrintPlace(*program));
+  // Every output is staged first, complete, beside its file, and then all
+  // are renamed into place: a run that cannot write one writes none.
+  std::vector<std::pair<std::string, std::string>> outputs = {{opt.output, PrintPlace(*program)}};
+  if (!opt.report.empty()) {
+    outputs.emplace_back(opt.report, ImportReportJson(importer.summary(), importer.fates(), BaseName(opt.list)));
+  }
+  if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(importer.setup_sheet()));
+  if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(importer.setup_sheet()));
+  Status written = WriteFilesAtomically(outputs);
   if (!written) {
-    std::fputs(summary.c_str(), stderr);
+    SaySummary(summary);
     options.exit_code = ReportIoError(written.error());
     return;
   }
   if (opt.output != "-") {
     summary += fmt::format("  next:    smtcal verify {} --cell {}\n", ShellWord(opt.output), ShellWord(opt.cell));
   }
-  std::fputs(summary.c_str(), stderr);
+  SaySummary(summary);
 }
 
 }  // namespace
@@ -393,11 +428,27 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   // Where the board is.
   cmd->add_option("--fixture", opt.fixture, "the cell fixture the board is on (default: the cell's only fixture)");
   cmd->add_option("--origin", opt.origin,
-                  "X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (default: the parts centred\n"
-                  "on the largest calibrated region on the fixture, else 0,0)")
-      ->check(PairValidator());
-  cmd->add_option("--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)")
-      ->check(CLI::Range(-limits::kMaxAbsAngleDeg, limits::kMaxAbsAngleDeg));
+                  fmt::format("X,Y: the board origin in the fixture frame, mm, e.g. -5,10 (each {}; default: the "
+                              "board's outline\nin the fixture's pocket, else centred on its largest calibrated region, "
+                              "else 0,0)",
+                              RangeText(limits::kPositionMm)))
+      ->check(PairValidator())
+      ->type_name("X,Y");
+  cmd->add_option("--board", opt.board,
+                  fmt::format("W,H or X,Y,W,H: the board's outline in the list's coordinates seen from the top, mm\n"
+                              "(its lower left corner X,Y, default 0,0: where KiCad's drill/place file origin is when\n"
+                              "it was put on that corner; X, Y each {}; W, H each {}); a part outside it is an error\n"
+                              "(default: the parts' bounding box)",
+                              RangeText(limits::kPositionMm), RangeText(limits::kLengthMm)))
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            Result<std::array<double, 4>> board = ParseBoard(text);
+            return board ? std::string() : board.error().message;
+          },
+          ""))
+      ->type_name("W,H");
+  AddNumberOption(*cmd, "--rotation", opt.rotation_deg, "the board's x axis against the fixture's, degrees (default 0)",
+                  limits::kAngleDeg);
   cmd->add_option("--mirror", opt.mirror,
                   "the board coordinate that changes sign: none, x or y (default: none for the top side, x for\n"
                   "the bottom side, the board turned over about its y axis)")
@@ -412,27 +463,39 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
                   "mirrored with the positions) or bottom-view (as seen from below, kept)")
       ->check(CLI::IsMember({"top-view", "bottom-view"}))
       ->capture_default_str();
-  cmd->add_option("--panel", opt.panel, "CxR: a panel of C columns and R rows of boards (default 1x1)")
+  cmd->add_option("--panel", opt.panel,
+                  fmt::format("CxR: a panel of C columns and R rows of boards (default 1x1; each {}, at most {} "
+                              "boards)",
+                              RangeText(limits::kPalletCount), limits::kMaxPanelBoards))
       ->check(CLI::Validator(
           [](const std::string& text) {
-            return ParsePanel(text) ? std::string() : "expected CxR, e.g. 3x2 (at most 10000 boards)";
+            Result<std::array<int, 2>> panel = ParsePanel(text);
+            return panel ? std::string() : panel.error().message;
           },
-          "CxR"));
-  cmd->add_option("--pitch", opt.pitch, "DX,DY: the distance between the panel's boards along its x and y, mm")
-      ->check(PairValidator());
-  cmd->add_option("--place-z", opt.place_z_mm,
+          ""))
+      ->type_name("CxR");
+  cmd->add_option("--pitch", opt.pitch,
+                  fmt::format("DX,DY: the distance between the panel's boards along its x and y, mm (each {})",
+                              RangeText(limits::kPositionMm)))
+      ->check(PairValidator())
+      ->type_name("X,Y");
+  AddNumberOption(*cmd, "--place-z", opt.place_z_mm,
                   "z of the placements, mm: the robot z of the board's top (default: the fixture's place_z_mm\n"
-                  "in the cell; without either it is an error)")
-      ->check(CLI::Range(-kMaxLengthMm, kMaxLengthMm));
+                  "in the cell; without either it is an error)",
+                  limits::kPositionMm);
 
   // The program.
-  cmd->add_option("--vacuum", opt.vacuum, "the gripper's vacuum output, the program's Vacuum (default 8)")
-      ->check(CLI::Range(limits::kVacuumOutputMin, limits::kVacuumOutputMax))
+  AddNumberOption(*cmd, "--vacuum", opt.vacuum, "the gripper's vacuum output, the program's Vacuum (default 8)",
+                  limits::kVacuumOutput)
       ->capture_default_str();
   cmd->add_option("--angles", opt.angles, "rotations in the program: signed (-180..180) or positive (0..360)")
       ->check(CLI::IsMember({"signed", "positive"}))
       ->capture_default_str();
   cmd->add_option("--name", opt.name, "the program's name (default: from the output file's name)");
+  cmd->add_option("--report", opt.report, "write the import report: every row of the list and what became of it (JSON)");
+  cmd->add_option("--setup-sheet", opt.setup_sheet,
+                  "write the feeder set-up sheet, which part goes in which feeder, lane or pocket, as a text table");
+  cmd->add_option("--setup-csv", opt.setup_csv, "write the feeder set-up sheet as CSV");
   cmd->footer(
       "Every row becomes a placement or a diagnostic at its line; the summary on stderr counts rows\n"
       "read, placed and skipped by reason. Exit codes: 0 ok, 1 errors in the list, the cell or the\n"

@@ -16,6 +16,7 @@
 #include "backend/reports/simulate_report.h"
 #include "base/text_output.h"
 #include "calibration/cell.h"
+#include "calibration/limits.h"
 #include "frontend/parse.h"
 #include "frontend/truth_toml.h"
 #include "ir/symbols.h"
@@ -112,20 +113,40 @@ bool FitsInMemory(const CompileState& state, const SimOptions& sim, GlobalOption
   return false;
 }
 
+// The work of a run is its planned placements, each in six modes: bounded
+// by limits::kMaxSimulatedPlacements before it starts (a usage error: fewer
+// --cycles fit), whatever the machine's memory would allow.
+bool WithinPlacementLimit(const CompileState& state, const SimOptions& sim, GlobalOptions& options) {
+  const long planned = PlannedPlacements(state, sim);
+  if (planned <= limits::kMaxSimulatedPlacements) return true;
+  const long per_cycle = planned / sim.cycles;
+  options.exit_code = ReportUsageError(fmt::format(
+      "--cycles {}: {} cycles of {} placements are {} placements, more than the {} a run of simulate takes "
+      "(calibration/limits.h); give --cycles {} or fewer",
+      sim.cycles, sim.cycles, per_cycle, planned, limits::kMaxSimulatedPlacements,
+      std::max<long>(1, limits::kMaxSimulatedPlacements / std::max<long>(1, per_cycle))));
+  return false;
+}
+
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
-  if (OutputOverwritesInput("--svg", opt.svg, {opt.program_path, opt.cell_path, opt.truth_path}) ||
-      OutputOverwritesInput("--record", opt.record, {opt.program_path, opt.cell_path, opt.truth_path, opt.svg})) {
+  if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}, {"--truth", opt.truth_path}},
+                 {{"--svg", opt.svg}, {"--record", opt.record}, {"the report", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
-  if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
   // verify's verdicts on accuracy are what the simulation measures: they do
   // not stop it, the report says how many there were.
-  const std::size_t over_budget =
-      diags.Remove(DiagKind::BudgetOverTolerance) + diags.Remove(DiagKind::FixtureBudgetUnbounded);
+  compiled.report_budget_findings = false;
+  if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  std::size_t over_budget = 0;
+  for (const Target& target : compiled.program.compile->targets) {
+    if (!target.known || target.region == nullptr || target.kind == CorrectionKind::kUncorrected) continue;
+    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) continue;
+    if (!target.budget_bounded || target.budget_mm > target.region->tolerance_mm) ++over_budget;
+  }
   if (diags.has_errors()) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
@@ -145,7 +166,7 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   options.exit_code = PrintDiagnostics(diags, options);
   if (diags.has_errors()) return;
 
-  if (!FitsInMemory(state, opt.sim, options)) return;
+  if (!WithinPlacementLimit(state, opt.sim, options) || !FitsInMemory(state, opt.sim, options)) return;
   SimOptions sim = opt.sim;
   sim.record = !opt.record.empty();
   SimResult result = Simulate(state, truth, sim);
@@ -186,32 +207,33 @@ void AddSimulateCommand(CLI::App& app, GlobalOptions& options) {
   simulate->add_option("--truth", opt.truth_path,
                        "the true world (TOML, docs/simulate.md): error field, board pose distribution, sensor and "
                        "robot accuracy; default: derived from the cell's tables");
-  simulate->add_option("--cycles", opt.sim.cycles,
-                       "how many times each Cycle statement runs (at most 100000: every placed part's error is kept, "
-                       "56 bytes per planned placement; a run that does not fit in memory is refused, exit 3)")
-      ->check(CLI::Range(1, 100'000))
+  AddNumberOption(*simulate, "--cycles", opt.sim.cycles,
+                  "how many times each Cycle statement runs: every placed part's error is kept, 56 bytes per "
+                  "planned placement (a run that does not fit in memory is refused, exit 3), and a run plans at "
+                  "most 10000000 placements",
+                  limits::kSimCycles)
       ->capture_default_str();
-  simulate->add_option("--seed", opt.sim.seed, "the random seed: the same seed gives the same report")
+  AddNumberOption(*simulate, "--seed", opt.sim.seed, "the random seed: the same seed gives the same report",
+                  limits::kSimSeed)
       ->capture_default_str();
   simulate->add_flag("--json", opt.json, "print the report as JSON");
   simulate->add_option("--svg", opt.svg, "also write a picture: error scatter per mode and histograms");
   simulate->add_option("--record", opt.record,
                        "also write the record of every scan of the improved mode, as the controller's runtime logs "
                        "it (docs/monitor.md; read it with smtcal monitor)");
-  simulate->add_option("--missed-trip-rate", opt.sim.missed_trip_rate,
-                       "fault injection: probability per cycle that the sensor misses one trip")
-      ->check(CLI::Range(0.0, 1.0));
-  simulate->add_option("--dirty-marker-rate", opt.sim.dirty_marker_rate,
-                       "fault injection: probability per cycle that one trip is displaced along its leg by "
-                       "--dirty-marker-mm (a dirty marker)")
-      ->check(CLI::Range(0.0, 1.0));
-  simulate->add_option("--dirty-marker-mm", opt.sim.dirty_marker_mm, "the displacement of a dirty marker's trip")
-      ->check(CLI::Range(0.0, 10.0))
+  AddNumberOption(*simulate, "--missed-trip-rate", opt.sim.missed_trip_rate,
+                  "fault injection: probability per cycle that the sensor misses one trip", limits::kProbability);
+  AddNumberOption(*simulate, "--dirty-marker-rate", opt.sim.dirty_marker_rate,
+                  "fault injection: probability per cycle that one trip is displaced along its leg by "
+                  "--dirty-marker-mm (a dirty marker)",
+                  limits::kProbability);
+  AddNumberOption(*simulate, "--dirty-marker-mm", opt.sim.dirty_marker_mm, "the displacement of a dirty marker's trip",
+                  limits::kDirtyMarkerMm)
       ->capture_default_str();
-  simulate->add_option("--board-beyond-rate", opt.sim.board_beyond_rate,
-                       "fault injection: probability per cycle that the board lies 0.1 to 1 mm beyond the fixture's "
-                       "max_shift_mm")
-      ->check(CLI::Range(0.0, 1.0));
+  AddNumberOption(*simulate, "--board-beyond-rate", opt.sim.board_beyond_rate,
+                  "fault injection: probability per cycle that the board lies 0.1 to 1 mm beyond the fixture's "
+                  "max_shift_mm",
+                  limits::kProbability);
   simulate->callback([&options] { RunSimulate(opt, options); });
 }
 

@@ -1,15 +1,21 @@
-// `smtcal table build|check|stats|forward|inverse|plot`: the error tables of
-// a calibrated region (docs/error-tables.md). The work is in
+// `smtcal table build|check|stats|forward|inverse|plot|diff`: the error
+// tables of a calibrated region (docs/error-tables.md). The work is in
 // frontend/table_csv, passes/error_table*, passes/inverse_calibration and
 // backend/table_*; this file only wires files, options and exit codes.
 #include <filesystem>
 #include <optional>
 
+#include "backend/reports/table_diff_report.h"
 #include "backend/reports/table_plot.h"
 #include "backend/reports/table_report.h"
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
+#include "calibration/table_diff.h"
+#include "calibration/tolerances.h"
+#include "frontend/cell_toml.h"
+#include "calibration/limits.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
 
@@ -19,14 +25,35 @@ namespace {
 struct TableOptions {
   std::string input;   // the table (or raw file for build)
   std::string points = "-";
+  bool points_given = false;
   std::string output = "-";
   bool json = false;
   std::string outside = "error";
   std::string solver = "default";
   double paper_tolerance_mm = kPaperSolverTolMm;
+  double tolerance_mm = kDefaultTableToleranceMm;  // check, stats: what the interpolation error is a share of
+  bool drop_outlier_readings = false;
+  // table diff
+  std::string new_input;
+  std::string cell;
+  std::string svg;
+  double threshold_um = kDiffDefaultThresholdUm;
+  bool exit_zero = false;
 };
 
 std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// The interpolation estimate of a table on its own: no cell, so no declared
+// roughness; a node or check point that states no noise counts as one
+// reading with the largest stddev the table states (0 when it states none).
+InterpolationEstimate TableInterpolation(const ErrorTable& table) {
+  double largest = 0;
+  for (const AxisTable& t : table.axes) {
+    for (const auto& sd : t.stddev_mm) largest = std::max(largest, sd.value_or(0.0));
+    for (const TableNode& check : t.checks) largest = std::max(largest, check.stddev_mm.value_or(0.0));
+  }
+  return EstimateInterpolationError(table, std::nullopt, largest);
+}
 
 // Loads and validates a table. Returns nullopt after setting the exit code
 // (I/O error, or input errors printed); diagnostics are printed by the caller
@@ -65,15 +92,18 @@ OutsidePolicy ParsePolicy(const std::string& name) {
   return OutsidePolicy::kError;
 }
 
-// The output options of `table` never name the command's own inputs.
-bool OutputIsInput(const TableOptions& opt, GlobalOptions& options) {
-  if (!OutputOverwritesInput("-o", opt.output, {opt.input, opt.points})) return false;
+// The files of a `table` command against each other (tools/commands.h):
+// POINTS is standard input unless given, so `table inverse -` clashes too.
+bool FilesClashIn(const TableOptions& opt, bool with_points, GlobalOptions& options) {
+  std::vector<NamedFile> inputs = {{"TABLE", opt.input}};
+  if (with_points) inputs.push_back({opt.points_given ? "POINTS" : "POINTS (standard input unless given)", opt.points});
+  if (!FilesClash(inputs, {{"-o", opt.output}})) return false;
   options.exit_code = kExitUsageError;
   return true;
 }
 
 void RunBuild(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Result<std::uint32_t> file = sources.Load(opt.input);
   if (!file) {
@@ -83,7 +113,9 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
   Diagnostics diags(sources);
   std::optional<std::vector<RawMeasurement>> raw = ReadRawMeasurements(file.value(), diags);
   std::optional<ErrorTable> table;
-  if (raw) table = BuildErrorTable(BaseName(opt.input), *raw, SourceLoc{file.value(), 0, 0}, diags);
+  BuildOptions build;
+  build.drop_outlier_readings = opt.drop_outlier_readings;
+  if (raw) table = BuildErrorTable(BaseName(opt.input), *raw, SourceLoc{file.value(), 0, 0}, diags, build);
   if (table) ValidateErrorTable(*table, diags, TableWarnings::kReport);
   std::string text;
   if (table && !diags.has_errors()) {
@@ -95,9 +127,14 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
 void RunCheck(const TableOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
-  if (LoadTable(opt.input, sources, diags, TableWarnings::kReport, options)) {
-    options.exit_code = PrintDiagnostics(diags, options);
-  }
+  std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kReport, options);
+  if (!table) return;
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
+  ReportCoarseGrid(interpolation, opt.tolerance_mm, "the table", interpolation.Origin(), diags);
+  options.exit_code = PrintDiagnostics(diags, options);
+  const std::string text = fmt::format("between the nodes: {}\n", InterpolationText(interpolation, opt.tolerance_mm));
+  if (Status written = WriteFileAtomically("-", text); !written) options.exit_code = ReportIoError(written.error());
+  if (options.exit_code == kExitOk) SayDone(options, "", NoErrorsText(table->name, diags.warning_count()));
 }
 
 void RunStats(const TableOptions& opt, GlobalOptions& options) {
@@ -109,13 +146,14 @@ void RunStats(const TableOptions& opt, GlobalOptions& options) {
   table->name = BaseName(table->name);
   TableStats stats = ComputeTableStats(*table);
   int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
+  const InterpolationEstimate interpolation = TableInterpolation(*table);
   Finish(diags, options, "-",
-         opt.json ? FormatStatsJson(*table, stats, analysis, bound)
-                  : FormatStatsText(*table, stats, analysis, bound));
+         opt.json ? FormatStatsJson(*table, stats, analysis, bound, interpolation, opt.tolerance_mm)
+                  : FormatStatsText(*table, stats, analysis, bound, interpolation, opt.tolerance_mm));
 }
 
 void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, true, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   TableAnalysis analysis;
@@ -164,12 +202,71 @@ void RunSolve(const TableOptions& opt, GlobalOptions& options, bool inverse) {
 }
 
 void RunPlot(const TableOptions& opt, GlobalOptions& options) {
-  if (OutputIsInput(opt, options)) return;
+  if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
   Diagnostics diags(sources);
   std::optional<ErrorTable> table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
   if (!table) return;
   Finish(diags, options, opt.output, PlotTableSvg(*table, BaseName(table->name)));
+}
+
+void RunDiff(const TableOptions& opt, GlobalOptions& options) {
+  if (FilesClash({{"A", opt.input}, {"B", opt.new_input}, {"--cell", opt.cell}},
+                 {{"--svg", opt.svg}, {"the diff", "-"}})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<ErrorTable> old_table = LoadTable(opt.input, sources, diags, TableWarnings::kSkip, options);
+  if (!old_table) return;
+  std::optional<ErrorTable> new_table = LoadTable(opt.new_input, sources, diags, TableWarnings::kSkip, options);
+  if (!new_table) return;
+  std::optional<cell::Cell> cell;
+  if (!opt.cell.empty()) {
+    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
+    if (!loaded) {
+      PrintDiagnostics(diags, options);
+      options.exit_code = ReportIoError(loaded.error());
+      return;
+    }
+    if (!loaded.value()) {
+      options.exit_code = PrintDiagnostics(diags, options);
+      return;
+    }
+    cell = std::move(loaded).value();
+  }
+  const TableChanges changes =
+      CompareTables(*old_table, *new_table, opt.threshold_um, cell ? &cell->regions : nullptr);
+  const TableDiffNames names{opt.input, opt.new_input, opt.cell};
+  options.exit_code = PrintDiagnostics(diags, options);
+  if (options.exit_code != kExitOk) return;
+  if (!opt.svg.empty()) {
+    const std::string svg = PlotTableDiffSvg(*old_table, *new_table, names);
+    if (svg.empty()) {
+      options.exit_code = ReportInputError("the tables share no area of 2 x 2 nodes to draw; no --svg written");
+      return;
+    }
+    if (Status written = WriteFileAtomically(opt.svg, svg); !written) {
+      options.exit_code = ReportIoError(written.error());
+      return;
+    }
+  }
+  const std::string text = opt.json ? FormatTableDiffJson(changes, names) : FormatTableDiffText(changes, names);
+  if (Status written = WriteFileAtomically("-", text); !written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  if (!opt.svg.empty()) SayDone(options, opt.svg, fmt::format("wrote the picture {}", opt.svg));
+  options.exit_code = TableDiffPasses(changes) || opt.exit_zero ? kExitOk : kExitInputError;
+}
+
+void AddToleranceOption(CLI::App& command, TableOptions& opt) {
+  AddNumberOption(command, "--tolerance", opt.tolerance_mm,
+                  "the placing tolerance (mm) the interpolation error between the nodes is a share of; above "
+                  "10 % the pitch to measure at next is advised",
+                  limits::kAccuracyMm)
+      ->capture_default_str();
 }
 
 }  // namespace
@@ -181,23 +278,33 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   table->require_subcommand(1);
 
   CLI::App* build = table->add_subcommand(
-      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm) into an error table;\n"
-               "warns about nodes whose scatter or set-to-set difference is far above the rest");
+      "build", "Average raw measurements (axis,x_mm,y_mm,set,repetition,error_mm[,kind]) into an error table\n"
+               "(kind check: check points off the nodes, averaged per position and kept in the table);\n"
+               "a reading or a whole set far from the other readings at its position is an error naming\n"
+               "its line and the likely slip; warns about nodes whose scatter or set-to-set difference is far above the rest");
   build->add_option("RAW", opt.input, "the raw measurement CSV ('-' for stdin)")->required();
   build->add_option("-o,--output", opt.output, "the error table to write ('-' for stdout)")->required();
+  build->add_flag("--drop-outlier-readings", opt.drop_outlier_readings,
+                  "leave readings (and sets) far from their node's others out of the means,\n"
+                  "each reported as a warning, instead of stopping at them");
   build->callback([&options] { RunBuild(opt, options); });
 
   CLI::App* check = table->add_subcommand(
       "check", "Validate an error table: grid, values, no fold (det(I + grad Delta) >= 0.5), slopes,\n"
-               "and warn where the error changes sign between nodes or exceeds half the pitch");
+               "and warn where the error changes sign between nodes or exceeds half the pitch; print the\n"
+               "interpolation error between the nodes as a share of --tolerance (and the pitch to measure at\n"
+               "when it is more than 10 %)");
   check->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
+  AddToleranceOption(*check, opt);
   check->callback([&options] { RunCheck(opt, options); });
 
   CLI::App* stats = table->add_subcommand(
       "stats", "The paper's statistics per axis (max, min, mean, origin shift by the means, max |Delta - mean|,\n"
-               "stddev summary) and the inverse calibration's contraction factor and iteration bound");
+               "stddev summary), the inverse calibration's contraction factor and iteration bound, and the\n"
+               "interpolation error between the nodes as a share of --tolerance");
   stats->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
   stats->add_flag("--json", opt.json, "print JSON instead of text");
+  AddToleranceOption(*stats, opt);
   stats->callback([&options] { RunStats(opt, options); });
 
   for (bool inverse : {false, true}) {
@@ -208,8 +315,9 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                 : "Direct calibration: the actual positions F(n) = n + Delta(n) the robot reaches when\n"
                   "commanded to n; prints x_mm,y_mm,residual_mm,iterations (residual and iterations 0)");
     solve->add_option("TABLE", opt.input, "the error table CSV")->required();
-    solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
-        ->capture_default_str();
+    CLI::Option* points =
+        solve->add_option("POINTS", opt.points, "CSV of points x_mm,y_mm (header optional; default '-', stdin)")
+            ->capture_default_str();
     solve->add_option("-o,--output", opt.output, "where to write the results ('-' for stdout)")
         ->capture_default_str();
     solve->add_option("--outside", opt.outside,
@@ -223,12 +331,14 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
                         "or paper (the paper's iterative interval search)")
           ->check(CLI::IsMember({"default", "paper"}))
           ->capture_default_str();
-      solve->add_option("--paper-tolerance", opt.paper_tolerance_mm,
-                        "the paper solver's stopping tolerance in mm")
-          ->check(CLI::PositiveNumber)
+      AddNumberOption(*solve, "--paper-tolerance", opt.paper_tolerance_mm, "the paper solver's stopping tolerance",
+                      limits::kPaperToleranceMm)
           ->capture_default_str();
     }
-    solve->callback([&options, inverse] { RunSolve(opt, options, inverse); });
+    solve->callback([&options, inverse, points] {
+      opt.points_given = points->count() > 0;
+      RunSolve(opt, options, inverse);
+    });
   }
 
   CLI::App* plot = table->add_subcommand(
@@ -237,6 +347,22 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   plot->add_option("TABLE", opt.input, "the error table CSV ('-' for stdin)")->required();
   plot->add_option("-o,--output", opt.output, "the SVG file to write ('-' for stdout)")->required();
   plot->callback([&options] { RunPlot(opt, options); });
+
+  CLI::App* diff = table->add_subcommand(
+      "diff", "Compare two error tables of a region (before and after re-measuring): every node's change per axis\n"
+              "(grids may differ: each node against the other table's interpolation on the common area), the\n"
+              "largest, mean and rms change, the nodes that changed most, per region with --cell; exit 1 when a\n"
+              "node changed by more than --threshold");
+  diff->add_option("A", opt.input, "the table in use now (CSV; '-' for stdin)")->required();
+  diff->add_option("B", opt.new_input, "the re-measured table (CSV; '-' for stdin)")->required();
+  diff->add_option("--cell", opt.cell, "a cell file: the changes within each of its regions' bounds too");
+  AddNumberOption(*diff, "--threshold", opt.threshold_um,
+                  "the gate: a node whose error changed by more than this many µm fails it", limits::kDiffThresholdUm)
+      ->capture_default_str();
+  diff->add_flag("--json", opt.json, "print JSON (schema smtcal-table-diff/1) instead of text");
+  diff->add_option("--svg", opt.svg, "also draw the change as an SVG file: colour maps of both axes in µm and arrows");
+  diff->add_flag("--exit-zero", opt.exit_zero, "report only: exit 0 even when the gate fails");
+  diff->callback([&options] { RunDiff(opt, options); });
 }
 
 }  // namespace smtcal::tools

@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libbenchmark-dev libmimalloc-dev
   clang-14 libclang-rt-14-dev  # the fuzz harnesses: clang and its libFuzzer runtime (tests/fuzz/)
   linuxcnc-uspace iproute2
+  linuxcnc-uspace-dev  # halcompile: the simulated robot of the measurement scenarios (tests/linuxcnc-sim/smtcal_robot_model.comp)
   locales
 )
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -62,20 +63,64 @@ std::string DescribeMoves(const Change& change) {
 
 std::string Where(const Change& change) { return change.function.empty() ? "" : " in " + change.function; }
 
+// ", position 1 of 3, at (155.080, 67.620) in region layer1": which of a
+// statement's positions, and where it must land.
+std::string PositionText(const MachineMove& move) {
+  std::string text = move.count > 1 ? fmt::format(", position {} of {}", move.index + 1, move.count) : "";
+  if (!move.board.empty() && move.comparable) {
+    text += fmt::format(", at ({:.3f}, {:.3f}) {}", move.required[0], move.required[1],
+                        move.region.empty() ? std::string("outside every region") : "in region " + move.region);
+  }
+  return text;
+}
+
+// "command 12.0 µm toward 180.0° (...) in robot base with Board at its
+// nominal pose, lands 12.0 µm; at most 12.1 µm with Board shifted ...".
+std::string DescribeMachineMove(const MachineMove& move) {
+  if (!move.comparable) return "cannot be compared on the machine: " + move.note;
+  std::string text = "command " + DescribeMove(move.command);
+  if (!move.board.empty()) text += fmt::format(" with {} at its nominal pose", move.board);
+  text += fmt::format(", lands {} µm", Um(move.lands.d_um));
+  if (!move.board.empty()) {
+    text += fmt::format("; at most {} µm with {} {}", Um(move.worst.d_um), move.board,
+                        move.worst_pose == "nominal pose" ? "at its nominal pose" : move.worst_pose);
+  } else if (std::fabs(move.worst.d_um - move.command.d_um) >= 0.05) {
+    text += fmt::format("; at most {} µm", Um(move.worst.d_um));
+  }
+  return text;
+}
+
+std::string MachineLines(const ProgramDiff& diff, const Change& change, const std::string& now, const std::string& was) {
+  std::string lines;
+  for (const MachineMove& move : change.machine) {
+    lines += fmt::format("{}: moved {}{}{} (was {}): {}", now, change.what, Where(change), PositionText(move), was,
+                         DescribeMachineMove(move));
+    if (move.beyond_threshold) lines += fmt::format(" [more than {} µm]", Um(diff.threshold_um));
+    lines += "\n";
+  }
+  return lines;
+}
+
 std::string ChangeLine(const ProgramDiff& diff, const Change& change) {
   const std::string was = change.old_side.loc.known() ? Loc(diff.old_file, change.old_side.loc) : "";
   const std::string now = change.new_side.loc.known() ? Loc(diff.new_file, change.new_side.loc) : "";
+  // A motion statement on the machine: its positions, not its text, moved.
+  const bool machine = diff.on_machine && change.is_target && !change.function.empty() &&
+                       (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged);
   std::string line;
   switch (change.kind) {
     case ChangeKind::kMoved:
+      if (machine) return MachineLines(diff, change, now, was);
       line = fmt::format("{}: moved {}{} (was {}): {}", now, change.what, Where(change), was, DescribeMoves(change));
+      if (diff.on_machine && change.is_target) line += " (in the text; the gate judges the positions that use it)";
       break;
     case ChangeKind::kChanged: {
       line = fmt::format("{}: changed {}{} (was {}: {})", now, change.what, Where(change), was, change.old_side.text);
       std::string details = change.note;
-      std::string moves = DescribeMoves(change);
+      std::string moves = machine ? std::string() : DescribeMoves(change);
       if (!moves.empty()) details += (details.empty() ? "" : "; ") + moves;
       if (!details.empty()) line += ": " + details;
+      if (machine) return line + "\n" + MachineLines(diff, change, now, was);
       break;
     }
     case ChangeKind::kAdded:
@@ -94,7 +139,12 @@ std::string ChangeLine(const ProgramDiff& diff, const Change& change) {
 
 std::string LargestWhere(const ProgramDiff& diff) {
   const Change& c = diff.changes[diff.summary.largest];
-  return fmt::format("{}, {}{}", Loc(diff.new_file, c.new_side.loc), c.what, Where(c));
+  std::string position;
+  if (!c.machine.empty() && c.machine[diff.summary.largest_position].count > 1) {
+    const MachineMove& move = c.machine[diff.summary.largest_position];
+    position = fmt::format(", position {} of {}", move.index + 1, move.count);
+  }
+  return fmt::format("{}, {}{}{}", Loc(diff.new_file, c.new_side.loc), c.what, Where(c), position);
 }
 
 std::string GateLine(const ProgramDiff& diff) {
@@ -111,7 +161,35 @@ std::string GateLine(const ProgramDiff& diff) {
   if (s.added > 0) why.push_back(fmt::format("{} added", s.added));
   if (s.removed > 0) why.push_back(fmt::format("{} removed", s.removed));
   if (s.changed > 0) why.push_back(fmt::format("{} changed", s.changed));
+  if (s.not_comparable > 0 && s.changed == 0) why.push_back(fmt::format("{} not comparable", s.not_comparable));
   return fmt::format("gate: failed: {}\n", fmt::join(why, ", "));
+}
+
+// "old.place: cell paper-cell, the cell it was compiled with, paper.cell.toml (sha256 3f2a9c1b0d4e...)".
+std::string SideCellLine(const std::string& file, const DiffSideCell& side) {
+  std::string cell_file;
+  for (const cell::CellFile& f : side.files) {
+    if (!f.table) cell_file = fmt::format(" (cell file sha256 {}...)", f.sha256.substr(0, 12));
+  }
+  return fmt::format("{}: {}cell {}, {}{}\n", file, side.compiled ? "" : "a source program, compiled here for ",
+                     side.cell_name, side.how, cell_file);
+}
+
+std::string MachineHeader(const ProgramDiff& diff) {
+  std::string text = SideCellLine(diff.old_file, *diff.old_cell) + SideCellLine(diff.new_file, *diff.new_cell);
+  text += diff.tables_differ.empty()
+              ? std::string("the cells hold the same tables and fixtures\n")
+              : fmt::format("the cells differ in: {}\n", fmt::join(diff.tables_differ, ", "));
+  text += "on the machine: each program through its own cell, the robot moving as NEW's cell says";
+  if (diff.poses > 1) {
+    text += fmt::format(
+        "; board targets at {} poses within the fixtures' check limits, as far out as the robot's scan accepts",
+        diff.poses);
+  }
+  if (!diff.refused_poses.empty()) {
+    text += fmt::format(" ({} refused by both programs' scans: not compared)", fmt::join(diff.refused_poses, ", "));
+  }
+  return text + "\n";
 }
 
 }  // namespace
@@ -120,12 +198,21 @@ std::string FormatDiffText(const ProgramDiff& diff) {
   std::string text = fmt::format("diff {} -> {} (threshold {} µm{})\n", diff.old_file, diff.new_file,
                                  Um(diff.threshold_um),
                                  diff.base_frame_known ? "" : "; fixture frames not resolved: no --cell");
+  if (diff.on_machine) text += MachineHeader(diff);
   for (const Change& change : diff.changes) text += ChangeLine(diff, change);
   if (diff.changes.empty()) text += "no changes\n";
   const Summary& s = diff.summary;
-  text += fmt::format("summary: {} targets compared, {} moved, {} by more than {} µm", s.targets_compared,
-                      s.targets_moved, s.beyond_threshold, Um(diff.threshold_um));
-  if (s.largest_um > 0) text += fmt::format(", largest {} µm ({})", Um(s.largest_um), LargestWhere(diff));
+  if (diff.on_machine) {
+    text += fmt::format("summary: {} commanded positions compared on the machine, {} moved, {} by more than {} µm",
+                        diff.positions_compared, s.targets_moved, s.beyond_threshold, Um(diff.threshold_um));
+    if (s.largest_um > 0) text += fmt::format(", largest {} µm ({})", Um(s.largest_um), LargestWhere(diff));
+    text += fmt::format("; {} points compared, {} moved in the text", diff.declarations_compared,
+                        s.points_moved_in_text);
+  } else {
+    text += fmt::format("summary: {} targets compared, {} moved, {} by more than {} µm", s.targets_compared,
+                        s.targets_moved, s.beyond_threshold, Um(diff.threshold_um));
+    if (s.largest_um > 0) text += fmt::format(", largest {} µm ({})", Um(s.largest_um), LargestWhere(diff));
+  }
   text += fmt::format("; {} not comparable; {} added, {} removed, {} changed\n", s.not_comparable, s.added, s.removed,
                       s.changed);
   return text + GateLine(diff);
@@ -149,15 +236,69 @@ ordered_json JsonSide(const Side& side) {
   return j;
 }
 
+ordered_json JsonMove(const Displacement& d) {
+  ordered_json m;
+  m["frame"] = d.frame;
+  m["dx_um"] = JsonNumber(d.dx_um);
+  m["dy_um"] = JsonNumber(d.dy_um);
+  m["dz_um"] = JsonNumber(d.dz_um);
+  m["du_deg"] = JsonNumber(d.du_deg, 7);
+  m["d_um"] = JsonNumber(d.d_um);
+  m["direction_deg"] = JsonNumber(d.direction_deg);
+  return m;
+}
+
+ordered_json JsonCell(const DiffSideCell& side) {
+  ordered_json j;
+  j["program"] = side.program;
+  j["compiled"] = side.compiled;
+  j["cell"] = side.cell_name;
+  j["how"] = side.how;
+  ordered_json files = ordered_json::array();
+  for (const cell::CellFile& file : side.files) {
+    files.push_back({{"kind", file.table ? "table" : "cell"}, {"path", file.path}, {"sha256", file.sha256}});
+  }
+  j["files"] = files;
+  return j;
+}
+
+ordered_json JsonMachineMove(const MachineMove& move) {
+  ordered_json j;
+  j["position"] = move.index + 1;
+  j["of"] = move.count;
+  j["board"] = move.board.empty() ? ordered_json() : ordered_json(move.board);
+  j["comparable"] = move.comparable;
+  j["note"] = move.note.empty() ? ordered_json() : ordered_json(move.note);
+  if (move.comparable) {
+    j["required"] = {{"x_mm", JsonNumber(move.required[0], 6)}, {"y_mm", JsonNumber(move.required[1], 6)}};
+    j["region"] = move.region.empty() ? ordered_json() : ordered_json(move.region);
+    j["command"] = JsonMove(move.command);
+    j["lands"] = JsonMove(move.lands);
+    j["worst"] = JsonMove(move.worst);
+    j["worst_pose"] = move.worst_pose.empty() ? ordered_json() : ordered_json(move.worst_pose);
+  }
+  j["beyond_threshold"] = move.beyond_threshold;
+  return j;
+}
+
 }  // namespace
 
 std::string FormatDiffJson(const ProgramDiff& diff) {
   ordered_json root;
-  root["schema"] = "smtcal-diff/1";
+  root["schema"] = "smtcal-diff/2";
   root["old"] = diff.old_file;
   root["new"] = diff.new_file;
   root["threshold_um"] = JsonNumber(diff.threshold_um);
   root["base_frame_known"] = diff.base_frame_known;
+  root["on_machine"] = diff.on_machine;
+  if (diff.on_machine) {
+    ordered_json differ = ordered_json::array();
+    for (const std::string& what : diff.tables_differ) differ.push_back(what);
+    root["cells"] = {{"old", JsonCell(*diff.old_cell)}, {"new", JsonCell(*diff.new_cell)}, {"differ", differ},
+                     {"poses", diff.poses}};
+  } else {
+    root["cells"] = ordered_json();
+  }
   ordered_json changes = ordered_json::array();
   for (const Change& change : diff.changes) {
     ordered_json c;
@@ -168,18 +309,11 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
     c["old"] = JsonSide(change.old_side);
     c["new"] = JsonSide(change.new_side);
     ordered_json moves = ordered_json::array();
-    for (const Displacement& d : change.moves) {
-      ordered_json m;
-      m["frame"] = d.frame;
-      m["dx_um"] = JsonNumber(d.dx_um);
-      m["dy_um"] = JsonNumber(d.dy_um);
-      m["dz_um"] = JsonNumber(d.dz_um);
-      m["du_deg"] = JsonNumber(d.du_deg, 7);
-      m["d_um"] = JsonNumber(d.d_um);
-      m["direction_deg"] = JsonNumber(d.direction_deg);
-      moves.push_back(m);
-    }
+    for (const Displacement& d : change.moves) moves.push_back(JsonMove(d));
     c["moves"] = moves;
+    ordered_json machine = ordered_json::array();
+    for (const MachineMove& move : change.machine) machine.push_back(JsonMachineMove(move));
+    c["machine"] = machine;
     c["beyond_threshold"] = change.beyond_threshold;
     c["note"] = change.note.empty() ? ordered_json() : ordered_json(change.note);
     changes.push_back(c);
@@ -198,7 +332,9 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
     const Change& c = diff.changes[s.largest];
     summary["largest"] = {{"d_um", JsonNumber(s.largest_um)}, {"what", c.what},
                           {"function", c.function.empty() ? ordered_json() : ordered_json(c.function)},
-                          {"new_line", c.new_side.loc.line}};
+                          {"new_line", c.new_side.loc.line},
+                          {"position", c.machine.empty() ? ordered_json()
+                                                         : ordered_json(c.machine[s.largest_position].index + 1)}};
   } else {
     summary["largest"] = ordered_json();
   }
@@ -216,7 +352,9 @@ constexpr double kMinPanelWidthPx = 340;  // room for the title and the labels o
 constexpr double kMinPanelHeightPx = 220;
 constexpr double kMarginPx = 60;        // left of the header
 constexpr double kAxisRoomPx = 70;      // left of a panel: the y ticks and label
-constexpr double kArrowFill = 0.12;     // the largest move drawn as this share of the panel's span
+constexpr double kArrowFill = 0.12;     // the largest move drawn at most this share of the panel's span
+constexpr double kArrowSpacingFill = 0.6;  // ... and of the targets' median spacing
+constexpr std::size_t kHeaderChars = 125;   // a header line at 12 px fits the 900 px picture
 constexpr std::size_t kLabelled = 5;    // the largest moves get a label
 constexpr double kLabelFontPx = 11;
 constexpr double kLeaderFromPx = 8;     // a label further than this from its arrow's tip gets a leader line
@@ -224,10 +362,10 @@ constexpr double kUmPerMm = 1000;
 
 std::string Num(double v) { return fmt::format("{:.2f}", NoNegativeZero(v, 0.01)); }
 
-// The largest 1, 2 or 5 times a power of ten not above v (v > 0).
+// The largest 1, 2, 2.5 or 5 times a power of ten not above v (v > 0).
 double NiceFloor(double v) {
   double power = std::pow(10.0, std::floor(std::log10(v)));
-  for (double m : {5.0, 2.0, 1.0}) {
+  for (double m : {5.0, 2.5, 2.0, 1.0}) {
     if (m * power <= v) return m * power;
   }
   return power;
@@ -236,7 +374,10 @@ double NiceFloor(double v) {
 struct Mark {
   const Change* change = nullptr;  // null: an unchanged target
   Pose4 at{};                      // old position (or new for added)
-  std::optional<Pose4> to;         // new position of a moved target
+  std::optional<Pose4> to;         // new position of a moved target (on the machine: at + the worst move)
+  double um = 0;                   // the move the gate judged
+  bool beyond = false;             // more than the threshold
+  std::string label;               // "R1", "line 66", "line 66 (1/3)"
 };
 
 struct Panel {
@@ -325,34 +466,43 @@ double Distance(double x, double y, const Box& b) {
 // first in eight directions, inside `area`, that covers no drawn mark, arrow
 // or earlier label. Right beside the tip it must also be nearer its own tip
 // than any other mark's point (`points`), so it cannot be read as another's;
-// further away a leader line says whose it is. Else the box that covers fewest.
+// further away a leader line says whose it is. Else the box that covers
+// fewest, another label last of all.
 Box PlaceLabel(double ax, double ay, double width, const Box& area, const std::vector<Box>& marks,
                const std::vector<Segment>& arrows, const std::vector<Box>& labels,
                const std::vector<std::pair<double, double>>& points) {
   const double height = kLabelFontPx + 3;
   Box best{};
   int best_hits = -1;
+  // Text over text is the worst a label can do, a leader line through
+  // another label the next worst: they count as many hits.
+  constexpr int kOverLabel = 100, kLeaderThroughLabel = 10;
   for (double d : {4.0, 12.0, 22.0, 34.0, 50.0, 70.0, 95.0, 125.0}) {
-    for (int direction = 0; direction < 8; ++direction) {
-      // E, W, N, S, NE, SE, NW, SW
-      const int hx = direction == 0 || direction == 4 || direction == 5 ? 1
-                     : direction == 1 || direction == 6 || direction == 7 ? -1
-                                                                         : 0;
-      const int vy = direction == 2 || direction == 4 || direction == 6 ? -1
-                     : direction == 3 || direction == 5 || direction == 7 ? 1
-                                                                         : 0;
-      const double diagonal = hx != 0 && vy != 0 ? 0.7 : 1.0;
-      const double left = hx > 0 ? ax + d * diagonal : hx < 0 ? ax - d * diagonal - width : ax - width / 2;
-      const double top = vy > 0 ? ay + d * diagonal : vy < 0 ? ay - d * diagonal - height : ay - height / 2;
+    for (int direction = 0; direction < 16; ++direction) {
+      // E, W, N, S, NE, SE, NW, SW first, then the eight between them.
+      static constexpr double kAngleDeg[16] = {0,    180,   90,    270,   45,    315,   135,  225,
+                                               22.5, 157.5, 67.5,  112.5, 202.5, 247.5, 292.5, 337.5};
+      const double c = std::cos(kAngleDeg[direction] * std::numbers::pi / 180);
+      const double s = std::sin(kAngleDeg[direction] * std::numbers::pi / 180);
+      const int hx = c > 0.3 ? 1 : c < -0.3 ? -1 : 0;
+      const int vy = s > 0.3 ? -1 : s < -0.3 ? 1 : 0;
+      // The first eight as they always were (diagonals at 0.7 d).
+      const double along = direction < 8 && hx != 0 && vy != 0 ? 0.7 : 1.0;
+      const double px = ax + d * (direction < 8 ? along * hx : c), py = ay + d * (direction < 8 ? along * vy : -s);
+      const double left = hx > 0 ? px : hx < 0 ? px - width : px - width / 2;
+      const double top = vy > 0 ? py : vy < 0 ? py - height : py - height / 2;
       const Box box{left, top, left + width, top + height};
       if (!box.Inside(area)) continue;
       int hits = 0;
       for (const Box& m : marks) hits += box.Overlaps(m);
       for (const Segment& a : arrows) hits += Crosses(a, box);
-      for (const Box& l : labels) hits += 2 * box.Overlaps(l);
+      for (const Box& l : labels) hits += kOverLabel * box.Overlaps(l);
       if (d <= kLeaderFromPx) {
         const double own = Distance(ax, ay, box);
         for (const auto& [x, y] : points) hits += Distance(x, y, box) < own + 6;
+      } else {  // its leader line must not run through a label placed before
+        const Segment leader{ax, ay, std::clamp(ax, box.x0, box.x1), std::clamp(ay, box.y0, box.y1)};
+        for (const Box& l : labels) hits += kLeaderThroughLabel * Crosses(leader, l);
       }
       if (hits == 0) return box;
       if (best_hits < 0 || hits < best_hits) {
@@ -367,15 +517,87 @@ Box PlaceLabel(double ax, double ay, double width, const Box& area, const std::v
   return best;
 }
 
+// The lines cut at spaces so none is longer than `width` characters (the
+// header stays within the picture).
+std::vector<std::string> Wrapped(const std::vector<std::string>& lines, std::size_t width) {
+  std::vector<std::string> out;
+  for (const std::string& line : lines) {
+    std::string rest = line;
+    while (rest.size() > width) {
+      std::size_t cut = rest.rfind(' ', width);
+      if (cut == std::string::npos || cut == 0) break;
+      out.push_back(rest.substr(0, cut));
+      rest = "  " + rest.substr(cut + 1);
+    }
+    out.push_back(rest);
+  }
+  return out;
+}
+
+// The median distance from a drawn target to its nearest neighbour (mm), 0
+// for fewer than two: how far apart the targets are.
+double MedianSpacingMm(const std::vector<Panel>& panels) {
+  std::vector<double> nearest;
+  for (const Panel& p : panels) {
+    // Distinct positions only: a statement in a loop draws one dot per run.
+    std::vector<std::pair<double, double>> at;
+    for (const Mark& m : p.marks) at.emplace_back(m.at[0], m.at[1]);
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    if (at.size() < 2) continue;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+      double best = INFINITY;
+      // Sorted by x: only neighbours nearer in x than the best so far can be nearer.
+      for (std::size_t j = i + 1; j < at.size() && at[j].first - at[i].first < best; ++j) {
+        best = std::min(best, std::hypot(at[j].first - at[i].first, at[j].second - at[i].second));
+      }
+      for (std::size_t j = i; j-- > 0 && at[i].first - at[j].first < best;) {
+        best = std::min(best, std::hypot(at[j].first - at[i].first, at[j].second - at[i].second));
+      }
+      nearest.push_back(best);
+    }
+  }
+  if (nearest.empty()) return 0;
+  std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2), nearest.end());
+  return nearest[nearest.size() / 2];
+}
+
 }  // namespace
 
 std::string PlotDiffSvg(const ProgramDiff& diff) {
   // Group what can be drawn by frame: robot base first, then fixtures by name.
   std::map<std::string, Panel> by_frame;
   for (const Change& change : diff.changes) {
-    if (!change.is_target || change.plot_frame.empty()) continue;
+    if (!change.is_target) continue;
+    const bool machine = diff.on_machine && !change.function.empty() &&
+                         (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged);
+    // On the machine the picture shows positions: a point's coordinates are text.
+    if (diff.on_machine && change.function.empty()) continue;
+    if (machine) {  // its positions, where NEW wants them at the nominal pose, and their worst moves
+      Panel& panel = by_frame["robot base"];
+      for (const MachineMove& move : change.machine) {
+        if (!move.comparable || !move.moved) continue;
+        Mark mark;
+        mark.change = &change;
+        mark.at = move.required;
+        mark.to = Pose4{move.required[0] + move.worst.dx_um / kUmPerMm, move.required[1] + move.worst.dy_um / kUmPerMm,
+                        move.required[2], move.required[3]};
+        mark.um = move.worst.d_um;
+        mark.beyond = move.beyond_threshold;
+        mark.label = move.count > 1 ? fmt::format("line {} ({}/{})", change.new_side.loc.line, move.index + 1,
+                                                  move.count)
+                                    : ShortName(change);
+        panel.marks.push_back(std::move(mark));
+        ++panel.compared;
+      }
+      continue;
+    }
+    if (change.plot_frame.empty()) continue;
     Mark mark;
     mark.change = &change;
+    mark.um = change.gate_um;
+    mark.beyond = change.beyond_threshold;
+    mark.label = ShortName(change);
     Panel& panel = by_frame[change.plot_frame];
     if (change.old_plot && change.new_plot) {
       mark.at = *change.old_plot;
@@ -394,7 +616,9 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   }
   for (std::size_t i = 0; i < diff.unchanged_plot.size(); ++i) {
     Panel& panel = by_frame[diff.unchanged_plot_frame[i]];
-    panel.marks.push_back({nullptr, diff.unchanged_plot[i], std::nullopt});
+    Mark unchanged;
+    unchanged.at = diff.unchanged_plot[i];
+    panel.marks.push_back(std::move(unchanged));
     ++panel.compared;
   }
   std::vector<Panel> panels;
@@ -411,10 +635,14 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   // no single static position to draw.
   std::size_t drawn = 0;
   for (const Panel& p : panels) drawn += p.compared;
-  const std::size_t not_drawn = diff.summary.targets_compared - std::min(drawn, diff.summary.targets_compared);
+  const std::size_t compared = diff.on_machine ? diff.positions_compared : diff.summary.targets_compared;
+  const std::string compared_what = diff.on_machine ? "commanded position" : "target";
+  const std::size_t not_drawn = compared - std::min(drawn, compared);
 
-  // One enlargement for all panels: the largest move spans kArrowFill of the
-  // widest panel.
+  // One enlargement for all panels: the longest arrow spans at most
+  // kArrowFill of the widest panel and kArrowSpacingFill of the median
+  // spacing of the targets, so arrows neither run off a panel nor into
+  // their neighbours.
   double largest_mm = 0, span_mm = 1;
   for (Panel& p : panels) {
     p.x0 = p.y0 = INFINITY;
@@ -428,14 +656,29 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     }
     span_mm = std::max({span_mm, p.x1 - p.x0, p.y1 - p.y0});
   }
-  const double enlarge = largest_mm > 0 ? NiceFloor(kArrowFill * span_mm / largest_mm) : 1;
+  const double spacing_mm = MedianSpacingMm(panels);
+  const double longest_mm = spacing_mm > 0 ? std::min(kArrowFill * span_mm, kArrowSpacingFill * spacing_mm)
+                                           : kArrowFill * span_mm;
+  const double enlarge = largest_mm > 0 ? std::max(1.0, NiceFloor(longest_mm / largest_mm)) : 1;
   const double pad_mm = std::max(0.08 * span_mm, enlarge * largest_mm);
   // The header: what the marks mean, then what the panels count.
   std::vector<std::string> header;
-  header.push_back(largest_mm > 0 ? fmt::format("grey: unchanged; blue dot and arrow: moved, old position to new, the "
-                                                 "arrow {} times enlarged (red: more than {} µm)",
-                                                 fmt::format("{:g}", enlarge), Um(diff.threshold_um))
-                                   : std::string("grey: unchanged (no drawn target moved)"));
+  header.push_back(
+      largest_mm == 0 ? std::string("grey: unchanged (no drawn target moved)")
+      : diff.on_machine
+          ? fmt::format("grey: unchanged; blue dot and arrow: moved on the machine, the dot where NEW wants the part "
+                        "(boards at their nominal poses), the arrow its worst move (red: more than {} µm)",
+                        Um(diff.threshold_um))
+          : fmt::format("grey: unchanged; blue dot and arrow: moved, old position to new (red: more than {} µm)",
+                        Um(diff.threshold_um)));
+  if (largest_mm > 0) {
+    header.push_back(fmt::format(
+        "arrows {} times enlarged: the longest, {} µm, is drawn {:.2f} mm long{}", fmt::format("{:g}", enlarge),
+        Um(largest_mm * kUmPerMm), enlarge * largest_mm,
+        spacing_mm > 0 ? fmt::format(", within {:g} of the targets' median spacing ({:.2f} mm) and {:g} of the panel",
+                                     kArrowSpacingFill, spacing_mm, kArrowFill)
+                       : fmt::format(", within {:g} of the panel", kArrowFill)));
+  }
   header.push_back(fmt::format("green +: added; red ×: removed. {}",
                                diff.base_frame_known ? "Fixture targets at the fixtures' nominal poses (--cell)."
                                                      : "Fixture targets in their fixture's frame (no --cell)."));
@@ -445,8 +688,8 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
       if (p.compared > 0) where.push_back(fmt::format("{} in the {}", p.compared, FrameName(p.frame)));
     }
     if (not_drawn > 0) where.push_back(fmt::format("{} not drawn", not_drawn));
-    std::string line = fmt::format("{} target{} compared (as in the text report)", diff.summary.targets_compared,
-                                   diff.summary.targets_compared == 1 ? "" : "s");
+    std::string line = fmt::format("{} {}{} compared{} (as in the text report)", compared, compared_what,
+                                   compared == 1 ? "" : "s", diff.on_machine ? " on the machine" : "");
     if (!where.empty()) line += ": " + fmt::format("{}", fmt::join(where, ", "));
     std::size_t added = 0, removed = 0;
     for (const Panel& p : panels) {
@@ -460,6 +703,7 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     header.push_back("not drawn: no single static position (offsets or pallet slots known only at run time, or a "
                      "frame that changed)");
   }
+  header = Wrapped(header, kHeaderChars);
   const double panel_top = 50 + 18 * static_cast<double>(header.size()) + 50;
   double x = kAxisRoomPx, height = 0;
   for (Panel& p : panels) {
@@ -486,11 +730,13 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   const double total_height = panel_top + height + 80;
 
   // The largest moves get labels.
-  std::vector<const Change*> ranked;
-  for (const Change& c : diff.changes) {
-    if (c.is_target && c.old_plot && c.new_plot && c.moved) ranked.push_back(&c);
+  std::vector<const Mark*> ranked;
+  for (const Panel& p : panels) {
+    for (const Mark& m : p.marks) {
+      if (m.change != nullptr && m.to && m.um > 0) ranked.push_back(&m);
+    }
   }
-  std::stable_sort(ranked.begin(), ranked.end(), [](const Change* a, const Change* b) { return a->gate_um > b->gate_um; });
+  std::stable_sort(ranked.begin(), ranked.end(), [](const Mark* a, const Mark* b) { return a->um > b->um; });
   if (ranked.size() > kLabelled) ranked.resize(kLabelled);
 
   std::string svg = fmt::format(
@@ -510,8 +756,8 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   }
   for (const Panel& p : panels) {
     svg += fmt::format("  <!-- panel: {} -->\n", SvgEscape(p.frame));
-    std::string counts = fmt::format("{} of the {} compared target{}", p.compared, diff.summary.targets_compared,
-                                     diff.summary.targets_compared == 1 ? "" : "s");
+    std::string counts = fmt::format("{} of the {} compared {}{}", p.compared, compared, compared_what,
+                                     compared == 1 ? "" : "s");
     if (p.added > 0) counts += fmt::format("; {} added", p.added);
     if (p.removed > 0) counts += fmt::format("; {} removed", p.removed);
     svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{}, mm</text>\n",
@@ -552,11 +798,11 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     svg += "  </g>\n  <g>\n";
     std::vector<Box> mark_boxes;
     std::vector<Segment> arrows;
-    std::vector<std::pair<const Change*, std::pair<double, double>>> points;  // dots and arrow tips, by owner
+    std::vector<std::pair<const Mark*, std::pair<double, double>>> points;  // dots and arrow tips, by owner
     for (const Mark& m : p.marks) {
       double px = p.Px(m.at[0]), py = p.Py(m.at[1]);
       mark_boxes.push_back({px - 5, py - 5, px + 5, py + 5});
-      points.push_back({m.change, {px, py}});
+      points.push_back({&m, {px, py}});
       if (m.change == nullptr) {
         svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"2.2\" fill=\"#aaa\"/>\n", Num(px), Num(py));
       } else if (m.change->kind == ChangeKind::kAdded) {
@@ -570,10 +816,10 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
         if (m.to) {
           double tx = m.at[0] + enlarge * ((*m.to)[0] - m.at[0]);
           double ty = m.at[1] + enlarge * ((*m.to)[1] - m.at[1]);
-          Arrow(svg, px, py, p.Px(tx), p.Py(ty), m.change->beyond_threshold ? "#d7191c" : "#2b83ba");
+          Arrow(svg, px, py, p.Px(tx), p.Py(ty), m.beyond ? "#d7191c" : "#2b83ba");
           arrows.push_back({px, py, p.Px(tx), p.Py(ty)});
           mark_boxes.push_back({p.Px(tx) - 4, p.Py(ty) - 4, p.Px(tx) + 4, p.Py(ty) + 4});
-          points.push_back({m.change, {p.Px(tx), p.Py(ty)}});
+          points.push_back({&m, {p.Px(tx), p.Py(ty)}});
         }
       }
     }
@@ -581,11 +827,11 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     // a thin leader line when one had to move away from its arrow.
     const Box area{p.left + 2, p.top + 2, p.left + p.width - 2, p.top + p.height - 2};
     std::vector<Box> labels;
-    for (const Change* c : ranked) {
-      if (c->plot_frame != p.frame) continue;
-      const double tx = p.Px((*c->old_plot)[0] + enlarge * ((*c->new_plot)[0] - (*c->old_plot)[0]));
-      const double ty = p.Py((*c->old_plot)[1] + enlarge * ((*c->new_plot)[1] - (*c->old_plot)[1]));
-      const std::string text = fmt::format("{}: {} µm", ShortName(*c), Um(c->gate_um));
+    for (const Mark* c : ranked) {
+      if (c < p.marks.data() || c >= p.marks.data() + p.marks.size()) continue;  // another panel's
+      const double tx = p.Px(c->at[0] + enlarge * ((*c->to)[0] - c->at[0]));
+      const double ty = p.Py(c->at[1] + enlarge * ((*c->to)[1] - c->at[1]));
+      const std::string text = fmt::format("{}: {} µm", c->label, Um(c->um));
       std::vector<std::pair<double, double>> others;
       for (const auto& [owner, at] : points) {
         if (owner != c) others.push_back(at);

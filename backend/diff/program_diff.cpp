@@ -545,7 +545,9 @@ SourceLoc ItemLoc(const Item& item) {
 
 constexpr double kUmPerMm = 1000;
 
-Displacement Between(const std::string& frame, const Pose4& a, const Pose4& b) {
+}  // namespace
+
+Displacement DisplacementBetween(const std::string& frame, const Pose4& a, const Pose4& b) {
   Displacement d;
   d.frame = frame;
   d.dx_um = (b[0] - a[0]) * kUmPerMm;
@@ -557,9 +559,16 @@ Displacement Between(const std::string& frame, const Pose4& a, const Pose4& b) {
   return d;
 }
 
-bool Zero(const Displacement& d) {
+bool IsZero(const Displacement& d) {
   return std::hypot(d.d_um, d.dz_um) <= kDiffSamePositionMm * kUmPerMm && std::fabs(d.du_deg) <= kDiffSameAngleDeg;
 }
+
+namespace {
+
+Displacement Between(const std::string& frame, const Pose4& a, const Pose4& b) {
+  return DisplacementBetween(frame, a, b);
+}
+bool Zero(const Displacement& d) { return IsZero(d); }
 
 std::string FrameLabel(const std::string& frame, bool taught) {
   if (taught && !frame.empty()) return "robot base, taught on " + frame;
@@ -680,7 +689,7 @@ class Differ {
     diff_.base_frame_known = options_.cell != nullptr ||
                              (FindDecl<ir::FixtureDecl>(old_) == nullptr && FindDecl<ir::FixtureDecl>(new_) == nullptr);
     MatchDeclarations(old_decls, new_decls);
-    Summarize();
+    Summarize(diff_);
     return std::move(diff_);
   }
 
@@ -717,21 +726,20 @@ class Differ {
       const std::string& compiled_name = IsCompiled(old_) ? diff_.old_file : diff_.new_file;
       diags_.Report(DiagKind::DiffCompiledWithSource, where, diags_.sources().File(source.file).name, compiled_name);
     }
-    if (options_.cell != nullptr) {
+    for (const ir::Program* program : {&old_, &new_}) {
+      const cell::Cell* cell = program == &old_ && options_.old_cell != nullptr ? options_.old_cell : options_.cell;
+      if (cell == nullptr) continue;
       std::vector<std::string> cell_names;
-      for (const cell::Fixture& fixture : options_.cell->fixtures) cell_names.push_back(fixture.name);
-      for (const ir::Program* program : {&old_, &new_}) {
-        for (const ir::StmtPtr& stmt : program->items) {
-          const auto* fixture = std::get_if<ir::FixtureDecl>(&stmt->node);
-          if (fixture == nullptr) continue;
-          bool found = std::any_of(cell_names.begin(), cell_names.end(),
-                                   [&](const std::string& n) { return sema::SameName(n, fixture->name); });
-          if (found) continue;
-          std::string suggestion = ClosestName(fixture->name, cell_names);
-          diags_.Report(DiagKind::DiffFixtureNotInCell, sema::NameAt(fixture->name_loc, fixture->name),
-                        fixture->name, options_.cell->path,
-                        suggestion.empty() ? "" : fmt::format(" (did you mean '{}'?)", suggestion));
-        }
+      for (const cell::Fixture& fixture : cell->fixtures) cell_names.push_back(fixture.name);
+      for (const ir::StmtPtr& stmt : program->items) {
+        const auto* fixture = std::get_if<ir::FixtureDecl>(&stmt->node);
+        if (fixture == nullptr) continue;
+        bool found = std::any_of(cell_names.begin(), cell_names.end(),
+                                 [&](const std::string& n) { return sema::SameName(n, fixture->name); });
+        if (found) continue;
+        std::string suggestion = ClosestName(fixture->name, cell_names);
+        diags_.Report(DiagKind::DiffFixtureNotInCell, sema::NameAt(fixture->name_loc, fixture->name), fixture->name,
+                      cell->path, suggestion.empty() ? "" : fmt::format(" (did you mean '{}'?)", suggestion));
       }
     }
   }
@@ -870,14 +878,32 @@ class Differ {
     Change change = Make(ChangeKind::kMoved, &a, &b, function);
     bool text_changed = StripCoordinates(a) != StripCoordinates(b);
     bool moved = false;
+    // A motion statement may move on the machine whatever its text says: remembered for CompareOnMachine.
+    const bool motion = a.branch <= 0 && ir::MotionTarget(*a.stmt) != nullptr && ir::MotionTarget(*b.stmt) != nullptr;
+    if (motion) {
+      MatchedStatement matched;
+      matched.old_stmt = a.stmt;
+      matched.new_stmt = b.stmt;
+      matched.old_loc = change.old_side.loc;
+      matched.new_loc = change.new_side.loc;
+      matched.text = b.text;
+      matched.function = function;
+      matched.insert_at = diff_.changes.size();
+      diff_.matched.push_back(std::move(matched));
+    }
+    // Pushes the change, remembering it for the matched statement.
+    auto push = [&](Change&& made) {
+      if (motion) diff_.matched.back().change = diff_.changes.size();
+      diff_.changes.push_back(std::move(made));
+    };
     if (a.placement && b.placement) {
-      if (change.is_target) ++diff_.summary.targets_compared;
+      if (change.is_target) ++(motion ? diff_.statements_compared : diff_.declarations_compared);
       bool comparable = comparer_.Compare(*a.placement, *b.placement, change);
       if (!comparable) {
         // Identical text in both programs around a run-time slot: nothing
         // the diff can see changed; anything else cannot be judged.
         if (a.text == b.text && change.note == a.placement->unknown_because && !text_changed) return;
-        if (change.is_target) ++diff_.summary.not_comparable;
+        change.comparable = false;
         text_changed = true;
       } else {
         moved = std::any_of(change.moves.begin(), change.moves.end(), [](const Displacement& d) { return !Zero(d); });
@@ -889,6 +915,7 @@ class Differ {
       if (change.old_plot && change.is_target) {
         diff_.unchanged_plot.push_back(*change.new_plot);
         diff_.unchanged_plot_frame.push_back(change.plot_frame);
+        diff_.unchanged_plot_statement.push_back(motion);
       }
       return;
     }
@@ -897,7 +924,7 @@ class Differ {
     // A target in a new frame keeps its zero moves ("0.0 µm in Board": the
     // same place); any other unmoved change has nothing to show.
     if (!moved && change.note.empty()) change.moves.clear();
-    diff_.changes.push_back(std::move(change));
+    push(std::move(change));
   }
 
   // The line with every XY(...) and every constant number in a target's
@@ -922,28 +949,6 @@ class Differ {
     return at == std::string::npos ? text : text.substr(0, at) + "<" + shape + ">" + text.substr(at + target_text.size());
   }
 
-  void Summarize() {
-    Summary& s = diff_.summary;
-    for (std::size_t i = 0; i < diff_.changes.size(); ++i) {
-      Change& change = diff_.changes[i];
-      switch (change.kind) {
-        case ChangeKind::kAdded: ++s.added; break;
-        case ChangeKind::kRemoved: ++s.removed; break;
-        case ChangeKind::kChanged: ++s.changed; break;
-        case ChangeKind::kMoved: break;
-      }
-      if (change.moved && change.is_target) {
-        ++s.targets_moved;
-        change.beyond_threshold = change.gate_um > options_.threshold_um;
-        if (change.beyond_threshold) ++s.beyond_threshold;
-        if (change.gate_um > s.largest_um) {
-          s.largest_um = change.gate_um;
-          s.largest = i;
-        }
-      }
-    }
-  }
-
   const ir::Program& old_;
   const ir::Program& new_;
   const DiffOptions& options_;
@@ -954,6 +959,70 @@ class Differ {
 };
 
 }  // namespace
+
+void RemapLines(ProgramDiff& diff, bool new_side, const std::vector<std::uint32_t>& map) {
+  for (Change& change : diff.changes) {
+    SourceLoc& loc = new_side ? change.new_side.loc : change.old_side.loc;
+    if (loc.known() && loc.line >= 1 && loc.line <= map.size()) {
+      loc.line = map[loc.line - 1];
+      loc.column = 1;
+    }
+  }
+}
+
+void Summarize(ProgramDiff& diff) {
+  Summary s;
+  s.targets_compared = diff.declarations_compared + (diff.on_machine ? diff.positions_compared : diff.statements_compared);
+  auto largest = [&](double um, std::size_t change, std::size_t position) {
+    if (um <= s.largest_um) return;
+    s.largest_um = um;
+    s.largest = change;
+    s.largest_position = position;
+  };
+  for (std::size_t i = 0; i < diff.changes.size(); ++i) {
+    Change& change = diff.changes[i];
+    switch (change.kind) {
+      case ChangeKind::kAdded: ++s.added; break;
+      case ChangeKind::kRemoved: ++s.removed; break;
+      case ChangeKind::kChanged: ++s.changed; break;
+      case ChangeKind::kMoved: break;
+    }
+    if (!change.is_target) continue;
+    const bool both = change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged;
+    if (diff.on_machine && both && !change.function.empty()) {  // a motion statement: its positions
+      change.beyond_threshold = false;
+      for (std::size_t p = 0; p < change.machine.size(); ++p) {
+        MachineMove& move = change.machine[p];
+        if (!move.comparable) {
+          ++s.not_comparable;
+          continue;
+        }
+        if (!move.moved) continue;
+        ++s.targets_moved;
+        move.beyond_threshold = move.worst.d_um > diff.threshold_um;
+        if (move.beyond_threshold) ++s.beyond_threshold;
+        change.beyond_threshold = change.beyond_threshold || move.beyond_threshold;
+        largest(move.worst.d_um, i, p);
+      }
+      continue;
+    }
+    if (!change.comparable) ++s.not_comparable;
+    // On the machine a point's coordinates are text: what it moves shows in
+    // the positions of the statements that use it, and the gate judges those
+    // (a taught point converted with a re-measured table moves in the text
+    // and not on the machine).
+    if (change.moved && diff.on_machine) {
+      ++s.points_moved_in_text;
+      change.beyond_threshold = false;
+    } else if (change.moved) {
+      ++s.targets_moved;
+      change.beyond_threshold = change.gate_um > diff.threshold_um;
+      if (change.beyond_threshold) ++s.beyond_threshold;
+      largest(change.gate_um, i, 0);
+    }
+  }
+  diff.summary = s;
+}
 
 ProgramDiff DiffPrograms(const ir::Program& old_program, const ir::Program& new_program, const DiffOptions& options,
                          Diagnostics& diags) {

@@ -16,5 +16,8 @@ struct EmbeddedFile {
 // The LinuxCNC runtime: every runtime/linuxcnc/*.ngc, sorted by name
 // (runtime/linuxcnc/README.md).
 const std::vector<EmbeddedFile>& LinuxCncRuntimeFiles();
+// The measuring program's runtime: every runtime/linuxcnc/measure/*.ngc,
+// sorted by name (`smtcal measure program`, docs/measure.md).
+const std::vector<EmbeddedFile>& LinuxCncMeasureFiles();
 
 }  // namespace smtcal

@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 
 #include "backend/c/c_data.h"
+#include "backend/linuxcnc/embedded_files.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/check.h"
 #include "calibration/fixture_geometry.h"
 
@@ -203,6 +205,7 @@ void AppendFixture(Layout& layout, const cell::Fixture& fixture, int directory_e
   layout.Set(at + L::kFxMaxLineResidual, f.max_line_residual, n + ": max_line_residual_mm");
   layout.Set(at + L::kFxScanZ, fixture.scan_z_mm, n + ": scan z");
   layout.Set(at + L::kFxScanFeed, fixture.scan_speed_mm_s * 60, n + ": scan feed mm/min");
+  layout.Set(at + L::kFxLatchFeed, fixture.latch_speed_mm_s * 60, n + ": latch feed mm/min; 0: one stage");
   layout.Set(at + L::kFxHasFix, 0, n + ": not scanned yet");
   layout.Set(at + L::kFxStatus, 0, n + ": last scan status");
   layout.Set(at + L::kFxRecordCycles, 0, n + ": scans recorded since the start");
@@ -259,7 +262,34 @@ std::optional<std::string> LinuxCncDataProblem(const cell::Cell& cell) {
   return std::nullopt;
 }
 
-std::string EmitLinuxCncData(const cell::Cell& cell) {
+namespace {
+
+// The data file's text, with the runtime id `id` (none: the line left out).
+std::string DataText(const cell::Cell& cell, std::optional<long> id);
+
+std::uint32_t Fnv1a(std::uint32_t hash, std::string_view text) {
+  for (char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 16777619u;
+  }
+  return hash;
+}
+
+}  // namespace
+
+long LinuxCncRuntimeId(const cell::Cell& cell) {
+  std::uint32_t hash = Fnv1a(2166136261u, SMTCAL_VERSION);
+  for (const EmbeddedFile& file : LinuxCncRuntimeFiles()) hash = Fnv1a(Fnv1a(hash, file.name), file.text);
+  hash = Fnv1a(hash, DataText(cell, std::nullopt));
+  hash = Fnv1a(hash, EmitLinuxCncScanAbort(cell));
+  return static_cast<long>(hash & 0x7fffffffu);
+}
+
+std::string EmitLinuxCncData(const cell::Cell& cell) { return DataText(cell, LinuxCncRuntimeId(cell)); }
+
+namespace {
+
+std::string DataText(const cell::Cell& cell, std::optional<long> id) {
   const std::optional<std::string> problem = LinuxCncDataProblem(cell);
   SMTCAL_CHECK(!problem, "EmitLinuxCncData on a cell that does not fit the LinuxCNC runtime");
   Layout layout;
@@ -281,6 +311,8 @@ std::string EmitLinuxCncData(const cell::Cell& cell) {
       "; numbered parameters #{}..#{} (layout: runtime/linuxcnc/README.md) and marks every\n"
       "; fixture not scanned yet. Lengths mm, angles degrees, base frame.\n",
       CommentText(cell.name), CommentText(cell.path), SMTCAL_VERSION, L::kFirst, layout.next() - 1);
+  // The files the data came from: `smtcal diff` names them.
+  for (const cell::CellFile& file : cell.files) out += fmt::format("; {}\n", CommentText(cell::CellFileLine(file)));
   out += "o<smtcal_data> sub\n";
   out += fmt::format("#{} = 0  ; not loaded while loading\n", L::kVersion);
   out += fmt::format("#{} = {}  ; region count\n", L::kRegionCount, cell.regions.size());
@@ -289,11 +321,16 @@ std::string EmitLinuxCncData(const cell::Cell& cell) {
   out += fmt::format("#{} = {}  ; fixture directory at\n", L::kFixtureDirectory, fixture_directory);
   out += fmt::format("#{} = {}  ; safe z (robot safe_limz_mm)\n", L::kSafeZ, LinuxCncNumber(cell.robot.safe_limz_mm));
   out += fmt::format("#{} = 0  ; a failed check aborts\n", L::kReportOnly);
+  if (id) {
+    out += fmt::format("{} = {}  ; this runtime: the main program checks it\n", L::kRuntimeIdParameter, *id);
+  }
   out += layout.Text();
   out += fmt::format("#{} = {}  ; loaded: layout version\n", L::kVersion, L::kLayoutVersion);
   out += "o<smtcal_record_open> call  ; the cycle record: its begin line (smtcal_record_open.ngc)\n";
   out += "o<smtcal_data> endsub\n";
   return out;
 }
+
+}  // namespace
 
 }  // namespace smtcal

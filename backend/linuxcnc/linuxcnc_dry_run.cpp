@@ -50,4 +50,25 @@ std::string EmitLinuxCncDryRunProbe(const cell::Cell& cell) {
   return out + "o<smtcal_probe_trips> endsub\n";
 }
 
+std::string EmitLinuxCncDryRunIni(const std::string& dry_run_folder, const std::string& runtime_folder) {
+  return fmt::format(
+      "# rs274.ini - LinuxCNC's standalone interpreter rs274 on this dry run, written by smtcal {}\n"
+      "# (smtcal compile --target linuxcnc --dry-run-probe). For rs274 only, never a machine:\n"
+      "#   rs274 -i {}/{} -g PROGRAM.ngc\n"
+      "[RS274NGC]\n"
+      "PARAMETER_FILE = {}/{}\n"
+      "# the dry-run probe file first, then smtcal's runtime for the cell\n"
+      "SUBROUTINE_PATH = {}:{}\n",
+      SMTCAL_VERSION, dry_run_folder, kLinuxCncDryRunIni, dry_run_folder, kLinuxCncDryRunVar, dry_run_folder,
+      runtime_folder);
+}
+
+std::string LinuxCncZeroOffsets() {
+  // Every coordinate system and G92 offset 0, G54 (#5220 = 1) active: the
+  // work coordinates are the robot base frame, as the runtime needs.
+  std::string var;
+  for (int p = 5211; p <= 5230; ++p) var += fmt::format("{}\t{}\n", p, p == 5220 ? "1.000000" : "0.000000");
+  return var;
+}
+
 }  // namespace smtcal

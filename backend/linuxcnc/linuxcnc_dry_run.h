@@ -26,4 +26,14 @@ inline constexpr const char* kLinuxCncDryRunFile = "smtcal_probe_trips.ngc";
 // The text of the dry-run smtcal_probe_trips.ngc for the cell (deterministic).
 std::string EmitLinuxCncDryRunProbe(const cell::Cell& cell);
 
+// rs274's INI for a dry run, beside that file: OUTDIR/dry-run/rs274.ini,
+// with the dry-run folder first on SUBROUTINE_PATH, then the runtime
+// (absolute paths: rs274 resolves them from wherever it is started), and
+// its parameter file rs274.var beside it (the work coordinates all zero).
+//   rs274 -i OUTDIR/dry-run/rs274.ini -g OUTDIR/PROGRAM.ngc
+inline constexpr const char* kLinuxCncDryRunIni = "rs274.ini";
+inline constexpr const char* kLinuxCncDryRunVar = "rs274.var";
+std::string EmitLinuxCncDryRunIni(const std::string& dry_run_folder, const std::string& runtime_folder);
+std::string LinuxCncZeroOffsets();
+
 }  // namespace smtcal

@@ -165,6 +165,8 @@ class Emitter {
         if (decl->output < 0 || decl->output >= cell::kLinuxCncMaxDio) {
           diags_.Report(DiagKind::LinuxCncIoBitOutOfRange, SourceRange(decl->output_loc), "vacuum output",
                         decl->output, "output", cell::kLinuxCncMaxDio - 1, "out");
+        } else {
+          io_.push_back({true, decl->output, "vacuum output", SourceRange(decl->output_loc)});
         }
       }
       if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
@@ -181,6 +183,9 @@ class Emitter {
   void CheckBit(const ir::Expr* bit, std::string_view what, std::string_view direction) {
     if (bit == nullptr) return;
     std::optional<int> value = sema::FoldInteger(bit);
+    if (value && *value >= 0 && *value < cell::kLinuxCncMaxDio) {
+      io_.push_back({direction == "output", *value, std::string(what), sema::ExprRange(*bit)});
+    }
     if (!value || (*value >= 0 && *value < cell::kLinuxCncMaxDio)) return;
     diags_.Report(DiagKind::LinuxCncIoBitOutOfRange, sema::ExprRange(*bit), what, *value, direction,
                   cell::kLinuxCncMaxDio - 1, direction == "input" ? "in" : "out");
@@ -368,12 +373,29 @@ class Emitter {
     out_.Append(fmt::format("{}{})\n", kHeaderMark,
                             Sanitize(fmt::format("{}: {} for LinuxCNC and cell {}. Do not edit: compile the source again.",
                                                  SMTCAL_VERSION, Quoted(source_name_), Quoted(cell_.name)))));
-    out_.Append("(Needs the subroutines directory of this output on [RS274NGC]SUBROUTINE_PATH; docs/linuxcnc.md.)\n");
+    out_.Append("(Needs smtcal's runtime for this cell on [RS274NGC]SUBROUTINE_PATH; docs/linuxcnc.md.)\n");
     out_.Append(fmt::format("(mm and degrees; u on the {} axis; vacuum sensor on motion.digital-in-{:02}.)\n",
                             linuxcnc_->rotation_axis, linuxcnc_->vacuum_sensor_input));
     SourceLoc loc = ProgramLoc();
-    Line("G21 G90 G17 G94", loc);
+    // G61, exact path: every move ends where it is commanded before the next
+    // starts, as the cycle-time model assumes (and a Jump must: a blended
+    // corner cuts towards the part); LinuxCNC also gives a blended move only
+    // half the axes' acceleration.
+    Line("G21 G90 G17 G94 G61", loc);
     Line("o<smtcal_data> call", loc);
+    // The runtime the path finds must be the one compiled with this program:
+    // the same cell data and the same smtcal (LinuxCncRuntimeId).
+    const std::string id = fmt::format("{}", LinuxCncRuntimeId(cell_));
+    const std::string message =
+        "the runtime on SUBROUTINE_PATH is not the one this program was compiled with [another cell or its "
+        "tables; or another smtcal]: compile it again with --ini";
+    const int known = NextOWord(), same = NextOWord();
+    Line(fmt::format("o{} if [EXISTS[#<_smtcal_runtime_id>] EQ 0]", known), loc);
+    Abort(message, loc);
+    Line(fmt::format("o{} endif", known), loc);
+    Line(fmt::format("o{} if [#<_smtcal_runtime_id> NE {}]", same, id), loc);
+    Abort(message, loc);
+    Line(fmt::format("o{} endif", same), loc);
   }
 
   SourceLoc ProgramLoc() const {
@@ -818,7 +840,17 @@ class Emitter {
   void EmitJump(const ir::Stmt& stmt, const Position& target, const ir::Expr* limz) {
     GExpr z = limz != nullptr ? Expr(*limz) : Num(cell_.robot.safe_limz_mm);
     Line(fmt::format("G0 Z{}", z), stmt.loc);
-    Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach (docs/measure.md, "Backlash"): every target is
+      // reached by the same last move as every node of the measurement.
+      Position from = target;
+      from.xyzu[0] = fmt::format("[{} - {}]", target.xyzu[0], Num(approach->x()));
+      from.xyzu[1] = fmt::format("[{} - {}]", target.xyzu[1], Num(approach->y()));
+      Line(fmt::format("G0 {}", Axes(from, false)), stmt.loc);
+      Line(fmt::format("G0 X{} Y{}", target.xyzu[0], target.xyzu[1]), stmt.loc);
+    } else {
+      Line(fmt::format("G0 {}", Axes(target, false)), stmt.loc);
+    }
     Line(fmt::format("G0 Z{}", target.xyzu[2]), stmt.loc);
   }
 
@@ -918,7 +950,14 @@ class Emitter {
     --indent_;
     block("o<pick_place_correct> endif");
     block("G0 Z#6");
-    block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    if (const auto& approach = cell_.robot.final_approach_mm) {
+      // The final approach: the last x-y move is robot.final_approach_mm, as
+      // at every node the tables were measured at (backlash taken up alike).
+      block(fmt::format("G0 X[#2 - {}] Y[#3 - {}] {}#5", Num(approach->x()), Num(approach->y()), axis));
+      block("G0 X#2 Y#3");
+    } else {
+      block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+    }
     block("G0 Z#4");
     block("o<pick_place_vacuum> if [#8 EQ 1]");
     ++indent_;
@@ -976,6 +1015,9 @@ class Emitter {
   bool suffix_made_ = false;
   int indent_ = 0;
   int next_oword_ = kFirstOWord;
+ public:
+  std::vector<LinuxCncIoUse> io_;  // the digital inputs and outputs the program uses (constant bits)
+ private:
   int next_switch_ = 1;
 };
 
@@ -988,21 +1030,43 @@ std::string FirstLine(const fs::path& path) {
   return line;
 }
 
+// Why `dir` is not a folder of smtcal's runtime files (only smtcal_*.ngc,
+// and in dry-run/ also rs274's INI and parameter file), or "".
+std::string NotOurRuntime(const fs::path& dir) {
+  if (!fs::is_directory(dir)) return fmt::format("'{}' exists and is not a directory", dir.string());
+  for (const fs::directory_entry& sub : fs::directory_iterator(dir)) {
+    const std::string name = sub.path().filename().string();
+    const bool rs274 = dir.filename() == kLinuxCncDryRunFolder &&
+                       (name == kLinuxCncDryRunIni || name == kLinuxCncDryRunVar);
+    if (sub.is_regular_file() && (rs274 || (name.starts_with("smtcal_") && sub.path().extension() == ".ngc"))) {
+      continue;
+    }
+    return fmt::format("'{}' holds '{}', which smtcal did not write", dir.string(), name);
+  }
+  return "";
+}
+
+// The folder holding `path`, for RemoveStaleTemporaries.
+std::string ParentOf(const fs::path& path) { return path.has_parent_path() ? path.parent_path().string() : "."; }
+
 // Why `dir` is not an earlier smtcal output, or "" when it is.
 std::string NotOurOutput(const fs::path& dir) {
   if (!fs::is_directory(dir)) return fmt::format("'{}' exists and is not a directory", dir.string());
   for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
     const fs::path& path = entry.path();
     if (entry.is_directory() && (path.filename() == "subroutines" || path.filename() == kLinuxCncDryRunFolder)) {
-      for (const fs::directory_entry& sub : fs::directory_iterator(path)) {
-        std::string name = sub.path().filename().string();
-        if (!sub.is_regular_file() || !name.starts_with("smtcal_") || sub.path().extension() != ".ngc") {
-          return fmt::format("'{}' holds '{}', which smtcal did not write", path.string(), name);
-        }
-      }
+      if (std::string why = NotOurRuntime(path); !why.empty()) return why;
       continue;
     }
-    if (entry.is_regular_file() && path.extension() == ".ngc" && FirstLine(path).starts_with(kHeaderMark)) continue;
+    const fs::path extension = path.extension();
+    if (entry.is_regular_file() && extension == ".ngc" && FirstLine(path).starts_with(kHeaderMark)) continue;
+    // The machine files: smtcal's INI and HAL, LinuxCNC's tool table and
+    // parameter file (LinuxCNC rewrites them).
+    if (entry.is_regular_file() && (extension == ".ini" || extension == ".hal") &&
+        FirstLine(path).find("written by smtcal") != std::string::npos) {
+      continue;
+    }
+    if (entry.is_regular_file() && (extension == ".tbl" || extension == ".var")) continue;
     return fmt::format("'{}' holds '{}', which smtcal did not write", dir.string(), path.filename().string());
   }
   return "";
@@ -1046,8 +1110,14 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
     return std::nullopt;
   }
   std::string source_name = program_path == "-" ? "stdin" : fs::path(program_path).filename().string();
-  if (!Emitter(program, state, source_name, main, diags).Run()) return std::nullopt;
+  Emitter emitter(program, state, source_name, main, diags);
+  if (!emitter.Run()) return std::nullopt;
   LinuxCncOutput output;
+  output.io = std::move(emitter.io_);
+  if (cell.linuxcnc) {
+    output.io.push_back({false, cell.linuxcnc->vacuum_sensor_input, "vacuum_sensor_input",
+                         cell.linuxcnc->range});
+  }
   output.main_name = LinuxCncMainName(program_path);
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
@@ -1074,7 +1144,8 @@ std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view ma
 }
 
 Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::path& outdir,
-                                                                   const std::string& main_name) {
+                                                                   const std::string& main_name,
+                                                                   const fs::path& runtime) {
   auto directory = std::unique_ptr<LinuxCncDirectory>(new LinuxCncDirectory());
   LinuxCncDirectory& d = *directory;
   d.target_ = outdir.has_filename() ? outdir : outdir.parent_path();
@@ -1086,10 +1157,43 @@ Result<std::unique_ptr<LinuxCncDirectory>> LinuxCncDirectory::Open(const fs::pat
                                d.target_.string(), why)};
     }
   }
+  // The temporaries of killed runs go first, as a file output's do: a
+  // folder "OUTDIR.tmp.PID" of a process that no longer runs, holding the
+  // subroutines/ folder Open() makes first (or, with --ini, only smtcal's
+  // files), and "RUNTIME.tmp.PID" holding only the runtime's files.
+  RemoveStaleTemporaries(ParentOf(d.target_), d.target_.filename().string() + ".tmp.", [](const std::string& stale) {
+    std::error_code ignored;
+    if (fs::is_directory(fs::symlink_status(stale, ignored)) &&
+        (fs::is_directory(fs::path(stale) / "subroutines", ignored) || NotOurOutput(stale).empty())) {
+      fs::remove_all(stale, ignored);
+    }
+  });
+  if (!runtime.empty()) {
+    d.runtime_ = runtime.has_filename() ? runtime : runtime.parent_path();
+    d.runtime_replaces_ = fs::exists(fs::symlink_status(d.runtime_, error));
+    if (d.runtime_replaces_) {
+      if (std::string why = NotOurRuntime(d.runtime_); !why.empty()) {
+        return Error{fmt::format("will not replace the runtime folder '{}' that the machine's SUBROUTINE_PATH "
+                                 "names: {}; name a folder of its own there",
+                                 d.runtime_.string(), why)};
+      }
+    }
+    RemoveStaleTemporaries(ParentOf(d.runtime_), d.runtime_.filename().string() + ".tmp.", [](const std::string& stale) {
+      std::error_code ignored;
+      if (fs::is_directory(fs::symlink_status(stale, ignored)) && NotOurRuntime(stale).empty()) {
+        fs::remove_all(stale, ignored);
+      }
+    });
+    d.runtime_temp_ = d.runtime_;
+    d.runtime_temp_ += fmt::format(".tmp.{}", ::getpid());
+    fs::remove_all(d.runtime_temp_, error);
+    fs::create_directories(d.runtime_temp_, error);
+    if (error) return Error{fmt::format("cannot create '{}': {}", d.runtime_temp_.string(), error.message())};
+  }
   d.temp_ = d.target_;
   d.temp_ += fmt::format(".tmp.{}", ::getpid());
   fs::remove_all(d.temp_, error);
-  fs::create_directories(d.temp_ / "subroutines", error);
+  fs::create_directories(d.runtime_.empty() ? d.temp_ / "subroutines" : d.temp_, error);
   if (error) return Error{fmt::format("cannot create '{}': {}", d.temp_.string(), error.message())};
   Result<std::unique_ptr<TextOutput>> main = TextOutput::Open((d.temp_ / main_name).string());
   if (!main) return main.error();
@@ -1101,14 +1205,46 @@ LinuxCncDirectory::~LinuxCncDirectory() {
   main_.reset();  // closes and removes an unfinished main program first
   std::error_code error;
   if (!committed_) fs::remove_all(temp_, error);
+  if (!runtime_temp_.empty() && !runtime_committed_) fs::remove_all(runtime_temp_, error);
 }
 
-Status LinuxCncDirectory::Commit(const LinuxCncOutput& output) {
+namespace {
+
+// Puts the finished `temp` in place of `target`: a rename, or an atomic swap
+// when `target` exists (the old one leaves under the temporary's name and is
+// removed).
+Status SwapIn(const fs::path& temp, const fs::path& target, bool replaces) {
+  if (!replaces) {
+    if (std::rename(temp.c_str(), target.c_str()) != 0) {
+      return Error{fmt::format("cannot write '{}': {}", target.string(), std::strerror(errno))};
+    }
+    return Ok{};
+  }
+  if (::renameat2(AT_FDCWD, temp.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0) {
+    return Error{fmt::format("cannot replace '{}': {}", target.string(), std::strerror(errno))};
+  }
+  std::error_code error;
+  fs::remove_all(temp, error);
+  return Ok{};
+}
+
+}  // namespace
+
+Status LinuxCncDirectory::Commit(const LinuxCncOutput& output, const std::vector<LinuxCncMachineFile>& machine) {
   std::error_code error;
   Status written = main_->Commit();
+  const fs::path subroutines = runtime_.empty() ? temp_ / "subroutines" : runtime_temp_;
+  for (const EmbeddedFile& file : output.more_mains) {
+    if (!written) break;
+    written = WriteText(temp_ / file.name, file.text);
+  }
   for (const EmbeddedFile& file : output.subroutines) {
     if (!written) break;
-    written = WriteText(temp_ / "subroutines" / file.name, file.text);
+    written = WriteText(subroutines / file.name, file.text);
+  }
+  for (const LinuxCncMachineFile& file : machine) {
+    if (!written) break;
+    written = WriteText(temp_ / file.name, file.text);
   }
   if (written && !output.dry_run.empty()) {
     fs::create_directories(temp_ / kLinuxCncDryRunFolder, error);
@@ -1118,20 +1254,22 @@ Status LinuxCncDirectory::Commit(const LinuxCncOutput& output) {
     if (!written) break;
     written = WriteText(temp_ / kLinuxCncDryRunFolder / file.name, file.text);
   }
+  if (written && !output.dry_run.empty()) {
+    // rs274's INI names the folders where they will be, absolute.
+    const fs::path dry_run = fs::absolute(target_ / kLinuxCncDryRunFolder, error).lexically_normal();
+    const fs::path runtime = fs::absolute(runtime_.empty() ? target_ / "subroutines" : runtime_, error).lexically_normal();
+    written = WriteText(temp_ / kLinuxCncDryRunFolder / kLinuxCncDryRunIni,
+                        EmitLinuxCncDryRunIni(dry_run.string(), runtime.string()));
+    if (written) written = WriteText(temp_ / kLinuxCncDryRunFolder / kLinuxCncDryRunVar, LinuxCncZeroOffsets());
+  }
   if (!written) return written;
-  if (!replaces_) {
-    if (std::rename(temp_.c_str(), target_.c_str()) != 0) {
-      return Error{fmt::format("cannot write '{}': {}", target_.string(), std::strerror(errno))};
-    }
-    committed_ = true;
-    return Ok{};
+  if (!runtime_.empty()) {
+    Status swapped = SwapIn(runtime_temp_, runtime_, runtime_replaces_);
+    if (!swapped) return swapped;
+    runtime_committed_ = true;
   }
-  // Swap the finished directory in atomically; the old one leaves under the
-  // temporary's name and is removed.
-  if (::renameat2(AT_FDCWD, temp_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) != 0) {
-    return Error{fmt::format("cannot replace '{}': {}", target_.string(), std::strerror(errno))};
-  }
-  fs::remove_all(temp_, error);
+  Status swapped = SwapIn(temp_, target_, replaces_);
+  if (!swapped) return swapped;
   committed_ = true;
   return Ok{};
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "backend/linuxcnc/embedded_files.h"
+#include "backend/linuxcnc/linuxcnc_machine.h"
 #include "base/diagnostics.h"
 #include "base/result.h"
 #include "base/source.h"
@@ -32,6 +33,8 @@ struct LinuxCncOutput {
   std::string main_name;                  // "<program file stem>.ngc"
   std::vector<EmbeddedFile> subroutines;  // the runtime's files and smtcal_data.ngc, sorted by name
   std::vector<EmbeddedFile> dry_run;      // OUTDIR/dry-run/ (--dry-run-probe, linuxcnc_dry_run.h), or none
+  std::vector<LinuxCncIoUse> io;          // the digital inputs and outputs the program and the cell use
+  std::vector<EmbeddedFile> more_mains;   // further programs beside the main one (the measuring programs), or none
 };
 
 // Lowers the program, writing the main program's text to `main` as it is
@@ -53,26 +56,37 @@ std::string LinuxCncMainName(const std::string& program_path);
 // own files are not repeated (they are runtime/linuxcnc/*.ngc verbatim).
 std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view main_text);
 
-// The output directory OUTDIR: OUTDIR/<main_name> and OUTDIR/subroutines/*,
-// written into a temporary sibling (OUTDIR.tmp.PID) and swapped in by a
-// rename at Commit(), so OUTDIR is never half-written; a directory never
-// committed leaves nothing behind. An existing OUTDIR is replaced only when
-// it is an earlier smtcal output (its .ngc files open with smtcal's header
-// line, subroutines/ holds only smtcal_*.ngc); anything else is refused by
-// Open() with an Error naming what is in the way.
+// The output directory OUTDIR: OUTDIR/<main_name>, the runtime in
+// OUTDIR/subroutines/* and a machine for the cell (OUTDIR/<stem>.ini, .hal,
+// .tbl, .var: EmitLinuxCncMachine) -- or, for a machine's INI given with
+// --ini, the runtime in the folder its SUBROUTINE_PATH names, shared by every
+// program compiled for that machine, and OUTDIR/<main_name> alone; with
+// --dry-run-probe also OUTDIR/dry-run/. Each directory is written into a
+// temporary sibling (DIR.tmp.PID) and swapped in by a rename at Commit(), the
+// runtime first, so none is ever half-written; nothing is left behind when
+// it is never committed. An existing directory is replaced only when it is
+// an earlier smtcal output (its .ngc files open with smtcal's header line,
+// subroutines/ and the runtime folder hold only smtcal_*.ngc, dry-run/ also
+// rs274's files, the machine files are smtcal's or LinuxCNC's tool table
+// and parameter file); anything else is refused by Open() with an Error
+// naming what is in the way; the temporaries a killed smtcal left are
+// removed the next time smtcal writes the same directory (as a file output's
+// temporary is).
 class LinuxCncDirectory {
  public:
+  // `runtime`: the runtime's own folder (--ini), or empty: OUTDIR/subroutines.
   static Result<std::unique_ptr<LinuxCncDirectory>> Open(const std::filesystem::path& outdir,
-                                                        const std::string& main_name);
+                                                        const std::string& main_name,
+                                                        const std::filesystem::path& runtime = {});
   ~LinuxCncDirectory();
   LinuxCncDirectory(const LinuxCncDirectory&) = delete;
   LinuxCncDirectory& operator=(const LinuxCncDirectory&) = delete;
 
   // The main program's file, written as EmitLinuxCnc produces it.
   TextOutput& main() { return *main_; }
-  // Completes the main program, writes the subroutines and swaps the
-  // directory in.
-  Status Commit(const LinuxCncOutput& output);
+  // Completes the main program, writes the runtime, the machine files and
+  // the dry run, and swaps the directories in.
+  Status Commit(const LinuxCncOutput& output, const std::vector<LinuxCncMachineFile>& machine = {});
 
  private:
   LinuxCncDirectory() = default;
@@ -80,6 +94,10 @@ class LinuxCncDirectory {
   std::filesystem::path temp_;
   bool replaces_ = false;  // OUTDIR exists (an earlier output)
   bool committed_ = false;
+  std::filesystem::path runtime_;       // the runtime's own folder, or empty
+  std::filesystem::path runtime_temp_;
+  bool runtime_replaces_ = false;
+  bool runtime_committed_ = false;
   std::unique_ptr<TextOutput> main_;
 };
 

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "backend/reports/capability_report.h"
+#include "backend/reports/table_report.h"
 #include "calibration/error_table.h"
 
 namespace smtcal {
@@ -136,6 +137,14 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
   }
   json process = json::object();
   for (const auto& [name, capability] : PredictedCapability(state)) process[name] = CapabilityJson(capability);
+  // What every region's table leaves open between its nodes: the budgets'
+  // `interpolation` part comes from these.
+  json regions = json::array();
+  for (const cell::Region& region : state.cell->regions) {
+    regions.push_back(json{{"name", region.name},
+                           {"table", region.table_path},
+                           {"interpolation", InterpolationJson(region.interpolation, region.tolerance_mm)}});
+  }
   return json{{"program", sources.File(program.file).name},
               {"cell", state.cell->path},
               {"errors", counts.errors},
@@ -145,6 +154,7 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
               {"taught_points", taught},
               {"targets", targets},
               {"cycles", cycles},
+              {"regions", regions},
               {"process", process}};
 }
 
@@ -194,6 +204,24 @@ std::string VerifySummaryText(const ir::Program& program, const CompileState& st
                            budget.shares[k].BudgetMm());
     }
     text += fmt::format("    its parts, each alone at 4σ (mm): {}\n", parts);
+  }
+  std::string interpolation;
+  for (const cell::Region& region : state.cell->regions) {
+    interpolation += fmt::format("{}{} {:.4f} ({})", interpolation.empty() ? "" : ", ", region.name,
+                                 region.interpolation.NormMm(), InterpolationKindShortName(region.interpolation.Kind()));
+  }
+  if (!interpolation.empty()) {
+    text += fmt::format("  interpolation between the table nodes (mm, budget part `interpolation`): {}\n", interpolation);
+  }
+  // Backlash has no part in the budget (docs/measure.md, "Backlash"): say so
+  // where it can move a placement, on fixture targets through the scan.
+  if (state.cell->robot.final_approach_mm && by_kind[CorrectionKind::kFixture] > 0) {
+    const Eigen::Vector2d& approach = *state.cell->robot.final_approach_mm;
+    text += fmt::format(
+        "  not in the budget: backlash. Targets reached by the final approach ({}, {}) mm carry the backlash their "
+        "tables measured; a scan trip whose leg runs against that approach may be off by up to an axis's backlash "
+        "across its edge, which moves every placement on the board (docs/measure.md, \"Backlash\")\n",
+        FormatMm(approach.x()), FormatMm(approach.y()));
   }
   const auto process = PredictedCapability(state);
   if (!process.empty()) {

@@ -128,8 +128,9 @@ std::string DriftText(const DriftModel& drift) {
 std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
   std::string field = fmt::format("tables {}", TablesName(truth.tables));
   if (truth.tables == TruthTables::kDerived) {
-    field += truth.noise ? fmt::format(" (nodes moved by {} x their standard error)", truth.perturbation_scale)
-                         : " (noise off: the tables as they are)";
+    field += truth.noise ? fmt::format(" (nodes moved by {} x their standard error", truth.perturbation_scale)
+                         : " (noise off: the nodes as they are";
+    field += fmt::format(", between them departing by {} x the interpolation estimate)", truth.interpolation_scale);
   }
   if (!truth.region_tables.empty()) field += fmt::format(", {} true table(s) given", truth.region_tables.size());
   switch (truth.outside) {
@@ -203,6 +204,21 @@ std::string SimulateReportText(const SimResult& result, const SimulateContext& c
       out += fmt::format("  {:<12} {}\n", SimModeName(m.mode), list);
     }
   }
+  std::string unchecked;
+  for (const ModeResult& m : result.modes) {
+    if (!UsesPeriphery(m.mode) || UsesCellChecks(m.mode)) continue;
+    std::string list;
+    for (const auto& [check, count] : m.would_stop_checks) {
+      list += fmt::format("{}{} {}", list.empty() ? "" : ", ", check, count);
+    }
+    unchecked += fmt::format("  {:<12} {} of {} cycles{}\n", SimModeName(m.mode), m.would_stop, m.cycles,
+                             list.empty() ? "" : " (" + list + ")");
+  }
+  if (!unchecked.empty()) {
+    out += "\nperiphery and paper run as the paper's cell did, without scan checks: only a missing trip or trips "
+           "that define no pose stop their cycles.\nThe cell's checks (the first that fails) would have stopped:\n" +
+           unchecked;
+  }
   if (o.missed_trip_rate > 0 || o.dirty_marker_rate > 0 || o.board_beyond_rate > 0) {
     out += fmt::format("\ncycles with an injected fault: {}; per mode, how many of them stopped and how many parts "
                        "they placed out of tolerance:\n", result.injected_cycles);
@@ -233,6 +249,9 @@ std::string SimulateReportText(const SimResult& result, const SimulateContext& c
   for (const ModeResult& m : result.modes) {
     std::string description(SimModeDescription(m.mode));
     if (m.mode == SimMode::kImproved) description += fmt::format(" (estimator {})", result.fixture_estimator);
+    if (UsesPeriphery(m.mode) && !UsesCellChecks(m.mode) && !result.paper_estimator.empty()) {
+      description += fmt::format(" (estimator {})", result.paper_estimator);
+    }
     out += fmt::format("  {:<12} {}\n", SimModeName(m.mode), description);
   }
   return out;
@@ -245,11 +264,19 @@ nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext
     const Summary s = Summarize(m.errors_um);
     nlohmann::json checks = nlohmann::json::object();
     for (const auto& [check, count] : m.fault_checks) checks[check] = count;
+    nlohmann::json would_stop = nlohmann::json::object();
+    for (const auto& [check, count] : m.would_stop_checks) would_stop[check] = count;
+    const nlohmann::json scan_checks = !UsesPeriphery(m.mode) ? nlohmann::json(nullptr)
+                                       : UsesCellChecks(m.mode) ? nlohmann::json("cell")
+                                                                : nlohmann::json("pose-only");
     modes.push_back({{"mode", SimModeName(m.mode)},
                      {"description", SimModeDescription(m.mode)},
                      {"cycles", m.cycles},
                      {"faults", m.faults},
                      {"fault_checks", checks},
+                     {"scan_checks", scan_checks},
+                     {"would_stop", m.would_stop},
+                     {"would_stop_checks", would_stop},
                      {"placed", m.placements},
                      {"within_tolerance", m.within},
                      {"within_fraction", m.placements == 0 ? nlohmann::json(nullptr)
@@ -276,6 +303,8 @@ nlohmann::json SimulateReportJson(const SimResult& result, const SimulateContext
           {"placements_planned", result.placements_planned},
           {"placements_not_simulated", result.unknown_targets},
           {"improved_estimator", result.fixture_estimator},
+          {"paper_estimator", result.paper_estimator.empty() ? nlohmann::json(nullptr)
+                                                             : nlohmann::json(result.paper_estimator)},
           {"verify_budget_findings", context.verify_findings},
           {"uncalibrated_accuracy_mm", result.uncalibrated_accuracy_mm},
           {"uncalibrated_accuracy_assumed", result.accuracy_assumed},
@@ -360,8 +389,14 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     const double cx = x0 + kPanel / 2, cy = y0 + kPanel / 2, per_um = kPanel / (2 * range_um);
     const Summary s = Summarize(m.errors_um);
     svg += fmt::format("<!-- panel: {} -->\n", SimModeName(m.mode));
-    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", x0, y0 - 24,
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-weight=\"bold\" fill=\"{}\">{}", x0, y0 - 24,
                        ModeColour(m.mode), SimModeName(m.mode));
+    if (UsesPeriphery(m.mode) && !UsesCellChecks(m.mode)) {
+      // The paper's modes run without the cell's checks: say so, and what they would have stopped.
+      svg += fmt::format("<tspan dx=\"8\" font-weight=\"normal\" fill=\"#444\">no scan checks (the cell's would stop {})"
+                         "</tspan>", m.would_stop);
+    }
+    svg += "</text>\n";
     if (m.placements == 0) {
       // Nothing to scatter: no axes, the reason in the panel.
       svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">nothing placed, {} of {} cycles stopped</text>\n", x0,
@@ -425,7 +460,9 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     std::vector<double> bins(kBins, 0.0);
     for (double e : m.errors_um) bins[std::min(kBins - 1, static_cast<int>(e / bin_um))] += 1;
     for (double& b : bins) b = m.errors_um.empty() ? 0 : 100 * b / static_cast<double>(m.errors_um.size());
-    top_share = std::max(top_share, *std::max_element(bins.begin(), bins.end()));
+    // The scale is the distribution's, not the last bin's: a mode that lands
+    // nearly everything beyond would flatten every other curve.
+    top_share = std::max(top_share, *std::max_element(bins.begin(), bins.end() - 1));
     shares.push_back(bins);
   }
   if (top_share <= 0) top_share = 1;
@@ -477,7 +514,7 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
     }
     std::string points;
     for (int b = 0; b < kBins; ++b) {
-      const double y = hist_top + hist_height * (1 - shares[i][b] / share_max);
+      const double y = hist_top + hist_height * (1 - std::min(shares[i][b], share_max) / share_max);
       points += fmt::format("{:.1f},{:.1f} {:.1f},{:.1f} ", hx0 + hw * b / kBins, y, hx0 + hw * (b + 1) / kBins, y);
     }
     svg += fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n", points,
@@ -486,6 +523,16 @@ std::string SimulateReportSvg(const SimResult& result, const SimulateContext& co
                        "stroke-width=\"3\"/><text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n",
                        hx0 + hw + 12, ly - 4, hx0 + hw + 36, ly - 4, ModeColour(m.mode), hx0 + hw + 42, ly,
                        SimModeName(m.mode));
+  }
+  // The last bins beyond the scale, clipped at its top: their shares written out.
+  double beyond_y = hist_top + 32;
+  for (std::size_t i = 0; i < shares.size(); ++i) {
+    if (result.modes[i].placements == 0 || shares[i].back() <= share_max) continue;
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\" fill=\"{}\">{}: {:.1f}% at {:g} µm or "
+                       "more (last bin, clipped)</text>\n",
+                       hx0 + hw - 8, beyond_y, ModeColour(result.modes[i].mode), SimModeName(result.modes[i].mode),
+                       shares[i].back(), hist_max_um - bin_um);
+    beyond_y += 16;
   }
   for (std::size_t i = 0; i < truth_lines.size(); ++i) {
     svg += fmt::format("<text x=\"{}\" y=\"{:.1f}\" fill=\"#666\">{}</text>\n", kLeft,

@@ -20,7 +20,7 @@ struct SimulateContext {
   const cell::Cell* cell = nullptr;
   const TruthSpec* truth = nullptr;
   // verify's findings the simulation measures instead of stopping for them:
-  // targets over their budget, fixtures whose budget cannot be bounded.
+  // Pick and Place targets over their budget or whose budget cannot be bounded.
   std::size_t verify_findings = 0;
 };
 

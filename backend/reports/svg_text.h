@@ -40,6 +40,12 @@ inline std::string SvgEscape(std::string_view text) {
   return out;
 }
 
+// A coordinate of the picture: 2 decimals, never "-0.00".
+inline std::string SvgNum(double v) {
+  std::string text = fmt::format("{:.2f}", v);
+  return text == "-0.00" ? "0.00" : text;
+}
+
 // The tick step of an axis spanning `span` (> 0) with at most about
 // `max_ticks` ticks: the smallest 1, 2, 2.5 or 5 times a power of ten that
 // gives no more.

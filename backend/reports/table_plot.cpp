@@ -69,10 +69,7 @@ double NiceFloor(double v) {
   return base;
 }
 
-std::string Num(double v) {
-  std::string text = fmt::format("{:.2f}", v);
-  return text == "-0.00" ? "0.00" : text;
-}
+std::string Num(double v) { return SvgNum(v); }
 
 // A tick label: up to 3 decimals, trailing zeros dropped.
 std::string Tick(double v) {
@@ -185,6 +182,11 @@ void DrawArrow(std::string& svg, double x0, double y0, double x1, double y1) {
 }  // namespace
 
 std::string PlotTableSvg(const ErrorTable& table, std::string_view title) {
+  return PlotTableSvg(table, TablePlotWords{fmt::format("Error tables of {}", title), "the error of the axis",
+                                            "the error vector (Δx, Δy)", "Δ{0}: the {0} errors"});
+}
+
+std::string PlotTableSvg(const ErrorTable& table, const TablePlotWords& words) {
   SMTCAL_CHECK(HasUsableShape(table), "plotting a table that is not usable");
   CalibrationMap map(table);
 
@@ -242,12 +244,14 @@ std::string PlotTableSvg(const ErrorTable& table, std::string_view title) {
   }
   svg += "    </linearGradient>\n  </defs>\n";
   svg += "  <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += fmt::format("  <text x=\"{}\" y=\"26\" font-size=\"17\" font-weight=\"bold\">Error tables of {}</text>\n",
-                     Num(kMarginLeft - 40), SvgEscape(title));
+  svg += fmt::format("  <text x=\"{}\" y=\"26\" font-size=\"17\" font-weight=\"bold\">{}</text>\n",
+                     Num(kMarginLeft - 40), SvgEscape(words.heading));
   svg += fmt::format(
-      "  <text x=\"{}\" y=\"46\" fill=\"#333\">colour: the error of the axis (µm, blue negative, red "
-      "positive); arrows: the error vector (Δx, Δy) at each node, {} times enlarged; dots: grid nodes</text>\n",
-      Num(kMarginLeft - 40), Tick(exaggeration));
+      "  <text x=\"{}\" y=\"46\" fill=\"#333\">colour: {} (µm, blue negative, red positive); arrows: {} at each "
+      "node, {} times enlarged{}; dots: grid nodes</text>\n",
+      Num(kMarginLeft - 40), SvgEscape(words.field), SvgEscape(words.arrows), Tick(exaggeration),
+      words.state_arrow_fill ? fmt::format(" (the longest: {:g} pitch)", kArrowFill)
+                             : std::string());
 
   for (const Panel& p : panels) {
     const AxisTable& t = *p.table;
@@ -256,9 +260,9 @@ std::string PlotTableSvg(const ErrorTable& table, std::string_view title) {
     const double range_um = max_abs > 0 ? LegendCeil(max_abs * kUmPerMm) : 1;
     std::string_view name = AxisName(p.axis);
     svg += fmt::format("  <!-- panel: the {} table -->\n", name);
-    svg += fmt::format(
-        "  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">Δ{}: the {} errors, {} x {} nodes</text>\n",
-        Num(p.left), Num(p.top - 12), name, name, t.nx(), t.ny());
+    svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{}, {} x {} nodes</text>\n",
+                       Num(p.left), Num(p.top - 12), SvgEscape(fmt::format(fmt::runtime(words.panel), name)), t.nx(),
+                       t.ny());
     DrawColourMap(svg, p, range_um / kUmPerMm);
     DrawAxes(svg, p);
     DrawLegend(svg, p, range_um);

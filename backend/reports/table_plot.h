@@ -18,4 +18,15 @@ namespace smtcal {
 // HasUsableShape.
 std::string PlotTableSvg(const ErrorTable& table, std::string_view title);
 
+// What the picture says of what it shows, for plots of other fields on a
+// table's grid (`table diff` draws the change of a table with it).
+struct TablePlotWords {
+  std::string heading;     // the bold first line
+  std::string field;       // what the colour is: "the error of the axis"
+  std::string arrows;      // what the arrows are: "the error vector (Δx, Δy)"
+  std::string panel;       // each panel's title before its node count, {0} for the axis name: "Δ{0}: the {0} errors"
+  bool state_arrow_fill = false;  // also say how long the longest arrow is drawn
+};
+std::string PlotTableSvg(const ErrorTable& table, const TablePlotWords& words);
+
 }  // namespace smtcal

@@ -1,6 +1,7 @@
 // Fixed-format text outputs of the error-table commands (see table_report.h).
 #include "backend/reports/table_report.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -38,32 +39,43 @@ std::string Range(const std::vector<double>& lines) {
 std::string FormatTableCsv(const ErrorTable& table, const std::vector<std::string>& comment) {
   std::string out;
   for (const std::string& line : comment) out += "# " + line + "\n";
-  bool stddev = false, count = false;
+  bool stddev = false, count = false, checks = false;
   for (const AxisTable& t : table.axes) {
     for (const auto& sd : t.stddev_mm) stddev = stddev || sd.has_value();
     for (int n : t.count) count = count || n > 0;
+    for (const TableNode& check : t.checks) {
+      stddev = stddev || check.stddev_mm.has_value();
+      count = count || check.count > 0;
+    }
+    checks = checks || !t.checks.empty();
   }
   out += "axis,x_mm,y_mm,error_mm";
   if (stddev) out += ",stddev_mm";
   if (count) out += ",n";
+  if (checks) out += ",kind";
   out += "\n";
+  auto row = [&](TableAxis axis, ReadingKind kind, double x, double y, double error, std::optional<double> sd, int n) {
+    out += fmt::format("{},{},{},{}", AxisName(axis), FormatMm(x), FormatMm(y), Fixed(error, 6));
+    if (stddev) out += "," + (sd ? Fixed(*sd, 6) : std::string());
+    if (count) out += "," + (n > 0 ? fmt::format("{}", n) : std::string());
+    if (checks) out += fmt::format(",{}", ReadingKindName(kind));
+    out += "\n";
+  };
   for (TableAxis axis : kTableAxes) {
     const AxisTable& t = table[axis];
     for (std::size_t j = 0; j < t.ny(); ++j) {
       for (std::size_t i = 0; i < t.nx(); ++i) {
         std::size_t k = t.Index(i, j);
-        out += fmt::format("{},{},{},{}", AxisName(axis), FormatMm(t.xs[i]), FormatMm(t.ys[j]),
-                           Fixed(t.error_mm[k], 6));
-        if (stddev) {
-          out += ",";
-          if (!t.stddev_mm.empty() && t.stddev_mm[k]) out += Fixed(*t.stddev_mm[k], 6);
-        }
-        if (count) {
-          out += ",";
-          if (!t.count.empty() && t.count[k] > 0) out += fmt::format("{}", t.count[k]);
-        }
-        out += "\n";
+        row(axis, ReadingKind::kNode, t.xs[i], t.ys[j], t.error_mm[k],
+            t.stddev_mm.empty() ? std::nullopt : t.stddev_mm[k], t.count.empty() ? 0 : t.count[k]);
       }
+    }
+  }
+  // The check points after every node, so a table's node rows stay where
+  // they were when check points are added.
+  for (TableAxis axis : kTableAxes) {
+    for (const TableNode& check : table[axis].checks) {
+      row(axis, ReadingKind::kCheck, check.x_mm, check.y_mm, check.error_mm, check.stddev_mm, check.count);
     }
   }
   return out;
@@ -75,8 +87,60 @@ std::vector<std::string> BuiltTableComment(std::string_view raw_name) {
           "n: their count"};
 }
 
+std::string InterpolationText(const InterpolationEstimate& estimate, double tolerance_mm) {
+  const GridAdvice advice = AdviseGrid(estimate, tolerance_mm);
+  std::string text = fmt::format("{} mm (Δx {}, Δy {} mm), {} % of ±{} mm, {}", Fixed(estimate.NormMm(), 4),
+                                 Fixed(estimate.axes[0].estimate_mm, 4), Fixed(estimate.axes[1].estimate_mm, 4),
+                                 Fixed(100 * advice.share, 1), FormatMm(tolerance_mm),
+                                 InterpolationKindDescription(estimate.Kind()));
+  const std::size_t checked = estimate.axes[0].checked_cells + estimate.axes[1].checked_cells;
+  const std::size_t cells = estimate.axes[0].cells + estimate.axes[1].cells;
+  if (estimate.HasCheckPoints()) {
+    text += fmt::format("; check points in {} of {} cells, largest residual {} mm", checked, cells,
+                        Fixed(std::max(estimate.axes[0].largest_residual_mm, estimate.axes[1].largest_residual_mm), 4));
+  }
+  if (advice.coarse) {
+    text += fmt::format("; more than {} %: measure at a pitch of at most {} mm (it has {} mm){}",
+                        Fixed(100 * kInterpolationShareOfTolerance, 0), Fixed(advice.pitch_mm, 1),
+                        Fixed(estimate.PitchMm(), 1),
+                        advice.check_points_would_settle ? ", or measure check points at the cell centres" : "");
+  }
+  return text;
+}
+
+nlohmann::ordered_json InterpolationJson(const InterpolationEstimate& estimate, double tolerance_mm) {
+  using nlohmann::ordered_json;
+  const GridAdvice advice = AdviseGrid(estimate, tolerance_mm);
+  auto optional = [](const std::optional<double>& v) { return v ? ordered_json(Round6(*v)) : ordered_json(); };
+  ordered_json axes;
+  for (TableAxis axis : kTableAxes) {
+    const AxisInterpolation& a = estimate[axis];
+    axes[std::string(AxisName(axis))] = {{"estimate_mm", Round6(a.estimate_mm)},
+                                         {"kind", InterpolationKindName(a.kind)},
+                                         {"at_mm", {Round6(a.at.x()), Round6(a.at.y())}},
+                                         {"curvature_mm", Round6(a.curvature_mm)},
+                                         {"check_points_mm", optional(a.check_points_mm)},
+                                         {"declared_mm", optional(a.declared_mm)},
+                                         {"check_points", a.check_points},
+                                         {"cells", a.cells},
+                                         {"checked_cells", a.checked_cells},
+                                         {"pitch_mm", Round6(a.pitch_mm)}};
+  }
+  return {{"mm", Round6(estimate.NormMm())},
+          {"x_mm", Round6(estimate.axes[0].estimate_mm)},
+          {"y_mm", Round6(estimate.axes[1].estimate_mm)},
+          {"kind", InterpolationKindName(estimate.Kind())},
+          {"lower_bound", estimate.Kind() == InterpolationKind::kCurvature},
+          {"tolerance_mm", tolerance_mm},
+          {"share", Round6(advice.share)},
+          {"coarse", advice.coarse},
+          {"advice_pitch_mm", advice.coarse ? ordered_json(advice.pitch_mm) : ordered_json()},
+          {"check_points_would_settle", advice.check_points_would_settle},
+          {"axes", std::move(axes)}};
+}
+
 std::string FormatStatsText(const ErrorTable& table, const TableStats& stats, const TableAnalysis& analysis,
-                            int iteration_bound) {
+                            int iteration_bound, const InterpolationEstimate& interpolation, double tolerance_mm) {
   const AxisStats& sx = stats.axes[0];
   const AxisStats& sy = stats.axes[1];
   const AxisTable& tx = table[TableAxis::X];
@@ -120,11 +184,12 @@ std::string FormatStatsText(const ErrorTable& table, const TableStats& stats, co
   out += fmt::format("measurements per node: x {}, y {}\n", counts(sx), counts(sy));
   out += fmt::format("inverse calibration: contraction factor L = {}, min det(I + ∇Δ) = {}, iteration bound {}\n",
                      Fixed(analysis.contraction, 6), Fixed(analysis.min_jacobian_det, 6), iteration_bound);
+  out += fmt::format("between the nodes: {}\n", InterpolationText(interpolation, tolerance_mm));
   return out;
 }
 
 std::string FormatStatsJson(const ErrorTable& table, const TableStats& stats, const TableAnalysis& analysis,
-                            int iteration_bound) {
+                            int iteration_bound, const InterpolationEstimate& interpolation, double tolerance_mm) {
   using nlohmann::ordered_json;
   ordered_json root;
   root["file"] = table.name;
@@ -158,6 +223,7 @@ std::string FormatStatsJson(const ErrorTable& table, const TableStats& stats, co
                      {"min_jacobian_det", Round6(analysis.min_jacobian_det)},
                      {"iteration_bound", iteration_bound},
                      {"residual_tolerance_mm", kInverseResidualTolMm}};
+  root["interpolation"] = InterpolationJson(interpolation, tolerance_mm);
   return JsonText(root);
 }
 

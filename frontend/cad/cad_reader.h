@@ -21,6 +21,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "base/diagnostics.h"
 #include "frontend/cad/cad_encoding.h"
@@ -71,7 +72,8 @@ class ListReader {
   std::size_t rows_read() const { return rows_read_; }
   std::size_t rows_with_errors() const { return rows_with_errors_; }
   // Rows left out for having no designator (ReadOptions::skip_empty_designators).
-  std::size_t rows_without_designator() const { return rows_without_designator_; }
+  std::size_t rows_without_designator() const { return lines_without_designator_.size(); }
+  const std::vector<std::uint32_t>& lines_without_designator() const { return lines_without_designator_; }
   const ToolVersion& tool_version() const { return tool_version_; }
 
  protected:
@@ -80,7 +82,7 @@ class ListReader {
   LengthUnit unit_ = LengthUnit::kMm;
   std::size_t rows_read_ = 0;
   std::size_t rows_with_errors_ = 0;
-  std::size_t rows_without_designator_ = 0;
+  std::vector<std::uint32_t> lines_without_designator_;
   ToolVersion tool_version_;
 };
 

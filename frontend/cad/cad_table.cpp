@@ -115,7 +115,7 @@ class TableReader final : public ListReader {
         return true;
       }
       if (skipped_row_ && diags_.error_count() == errors_before) {
-        ++rows_without_designator_;
+        lines_without_designator_.push_back(number);
         continue;
       }
       ++rows_with_errors_;

@@ -64,6 +64,10 @@ double Round(double value, double resolution) {
   return rounded == 0 ? 0.0 : rounded;  // no -0.0
 }
 
+// A length for messages and the summary: rounded to the list's resolution,
+// in its shortest form (372.21, not 372.21000000000004).
+std::string FormatLength(double mm) { return fmt::format("{}", Round(mm, kCadResolutionMm)); }
+
 double NormaliseAngle(double degrees, AngleRange range) {
   double u = std::fmod(degrees, 360.0);
   if (range == AngleRange::kPositive) {
@@ -263,6 +267,33 @@ std::string_view SkipReasonName(SkipReason reason) {
   return "?";
 }
 
+namespace {
+
+// "C3, C4, C5, ..." wrapped to lines of at most kSummaryWidth columns, each
+// continuation line indented by `indent` spaces.
+constexpr std::size_t kSummaryWidth = 100;
+std::string WrappedNames(const std::vector<std::string>& names, std::size_t first_column, std::size_t indent) {
+  std::string text;
+  std::size_t column = first_column;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string item = names[i] + (i + 1 < names.size() ? "," : "");
+    if (i > 0) {
+      if (column + 1 + item.size() > kSummaryWidth) {
+        text += "\n" + std::string(indent, ' ');
+        column = indent;
+      } else {
+        text += ' ';
+        ++column;
+      }
+    }
+    text += item;
+    column += item.size();
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string FormatImportSummary(const ImportSummary& s) {
   std::string text = fmt::format("import: {} row{} read ({})", s.rows_read, s.rows_read == 1 ? "" : "s", s.format);
   if (s.rows_with_errors > 0) text += fmt::format(", {} with errors", s.rows_with_errors);
@@ -286,6 +317,22 @@ std::string FormatImportSummary(const ImportSummary& s) {
     reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", s.skipped[r], SkipReasonName(static_cast<SkipReason>(r)));
   }
   text += fmt::format("  skipped: {}{}\n", skipped, reasons.empty() ? "" : " (" + reasons + ")");
+  // Every row left out, named, by reason and rule; the other side's rows
+  // are a job of their own, one line.
+  for (const SkipGroup& group : s.skip_groups) {
+    const std::size_t n = group.names.size();
+    const bool lines = group.reason == SkipReason::kNoDesignator;
+    if (group.reason == SkipReason::kOtherSide) {
+      text += fmt::format("    {}: {} part{}\n", group.why, n, n == 1 ? "" : "s");
+      continue;
+    }
+    // "    <rule>, 3 parts: C1, C2, C3" when that fits a line; else the
+    // names start on the next line, and wrap there.
+    const std::string head = fmt::format("    {}, {} {}{}:", group.why, n, lines ? "row" : "part", n == 1 ? "" : "s");
+    const std::string names = WrappedNames(group.names, 6, 6);
+    const bool one_line = names.find('\n') == std::string::npos && head.size() + 1 + names.size() <= kSummaryWidth;
+    text += head + (one_line ? " " : "\n      ") + names + "\n";
+  }
   if (!s.bottom.empty()) text += fmt::format("  bottom:  {}\n", s.bottom);
   return text;
 }
@@ -351,27 +398,85 @@ void CadImporter::Add(const cad::Row& row) {
   part.designator_range = row.designator_range;
   part.side_range = row.side_range;
   if (!Classify(row, part)) part.feeder = FindFeeder(row);
+  if (options_.keep_fates) {
+    fates_.emplace_back().row = row;
+  }
   parts_.push_back(std::move(part));
 }
 
-void CadImporter::ReportSkip(const Part& part, cad::Side placed_side) {
-  std::string designator = Printable(part.designator);
+void CadImporter::Skip(const Part& part, cad::Side placed_side) {
+  SkipReason reason;
+  std::string why;
   if (part.side != placed_side) {
-    diags_.Report(DiagKind::ImportSkippedSide, part.side_range, designator, cad::SideName(part.side),
-                  cad::SideName(placed_side));
-    ++summary_.skipped[static_cast<int>(SkipReason::kOtherSide)];
+    reason = SkipReason::kOtherSide;
+    why = fmt::format("on the {} side (--side {} imports them)", cad::SideName(part.side), cad::SideName(part.side));
   } else if (part.skip == SkipReason::kDnp) {
-    diags_.Report(DiagKind::ImportSkippedDnp, part.skip_range, designator, skip_details_[part.skip_detail][0]);
-    ++summary_.skipped[static_cast<int>(SkipReason::kDnp)];
+    reason = SkipReason::kDnp;
+    const std::string& by = skip_details_[part.skip_detail][0];
+    why = fmt::format("marked do-not-place by {} (--keep-dnp places them)",
+                      by.starts_with("its value ") ? "the value " + by.substr(10) : by);
   } else if (part.skip == SkipReason::kExcluded) {
+    reason = SkipReason::kExcluded;
     const std::array<std::string, 4>& detail = skip_details_[part.skip_detail];
-    diags_.Report(DiagKind::ImportExcluded, part.skip_range, designator, detail[0], detail[1], detail[2], detail[3]);
-    ++summary_.skipped[static_cast<int>(SkipReason::kExcluded)];
+    why = fmt::format("excluded: the {} matches {} '{}'", detail[0], detail[2], detail[3]);
   } else {
-    diags_.Report(DiagKind::ImportSkippedUnmapped, part.designator_range, designator, Quoted(part.package),
-                  Quoted(part.value));
-    ++summary_.skipped[static_cast<int>(SkipReason::kUnmapped)];
+    reason = SkipReason::kUnmapped;
+    why = fmt::format("no feeder holds package {}, value {} (--skip-unmapped)", Quoted(part.package), Quoted(part.value));
   }
+  ++summary_.skipped[static_cast<int>(reason)];
+  auto [it, fresh] = group_of_.emplace(std::make_pair(static_cast<int>(reason), why), summary_.skip_groups.size());
+  if (fresh) {
+    summary_.skip_groups.push_back({reason, why, {}});
+    group_first_.push_back(&part);
+  }
+  summary_.skip_groups[it->second].names.push_back(Printable(part.designator));
+  if (options_.keep_fates) {
+    RowFate& fate = fates_[static_cast<std::size_t>(&part - parts_.data())];
+    fate.reason = reason;
+    fate.why = std::move(why);
+  }
+}
+
+void CadImporter::ReportSkipGroups(cad::Side placed_side) {
+  // One warning per group, at its first row; the summary names every part.
+  for (std::size_t g = 0; g < summary_.skip_groups.size(); ++g) {
+    const SkipGroup& group = summary_.skip_groups[g];
+    if (group_first_[g] == nullptr) continue;  // rows without a designator: the reader reported each
+    const Part& first = *group_first_[g];
+    const std::size_t n = group.names.size();
+    const std::string subject = n == 1   ? fmt::format("{} is", group.names[0])
+                                : n == 2 ? fmt::format("{} and {} are", group.names[0], group.names[1])
+                                         : fmt::format("{} and {} other parts are", group.names[0], n - 1);
+    const std::string all = n > 2 ? "; the summary names them all" : "";
+    const char* them = n == 1 ? "it" : "them";
+    switch (group.reason) {
+      case SkipReason::kOtherSide:
+        diags_.Report(DiagKind::ImportSkippedSide, first.side_range, subject, cad::SideName(first.side),
+                      cad::SideName(placed_side), cad::SideName(first.side), them);
+        break;
+      case SkipReason::kDnp: {
+        const std::string& by = skip_details_[first.skip_detail][0];
+        diags_.Report(DiagKind::ImportSkippedDnp, first.skip_range, subject,
+                      by.starts_with("its value ") && n > 1 ? "their value " + by.substr(10) : by, them, them, all);
+        break;
+      }
+      case SkipReason::kExcluded: {
+        const std::array<std::string, 4>& detail = skip_details_[first.skip_detail];
+        const std::string what = n == 1 ? fmt::format("its {} '{}' matches", detail[0], detail[1])
+                                        : fmt::format("their {}s match", detail[0]);
+        diags_.Report(DiagKind::ImportExcluded, first.skip_range, subject, what, detail[2], detail[3], all);
+        break;
+      }
+      case SkipReason::kUnmapped:
+        diags_.Report(DiagKind::ImportSkippedUnmapped, first.designator_range, subject, Quoted(first.package),
+                      Quoted(first.value), all);
+        break;
+      case SkipReason::kNoDesignator:
+      case SkipReason::kCount: break;  // the reader reported each row
+    }
+  }
+  std::stable_sort(summary_.skip_groups.begin(), summary_.skip_groups.end(),
+                   [](const SkipGroup& a, const SkipGroup& b) { return a.reason < b.reason; });
 }
 
 void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
@@ -399,10 +504,34 @@ void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
   }
 }
 
+std::size_t CadImporter::FateIndex(const Part& part) const { return static_cast<std::size_t>(&part - parts_.data()); }
+
+void CadImporter::AddToSetup(SetupSlot& slot, const cad::FeederSpec& feeder, int k, bool is_lane, const Part& part,
+                             std::size_t board, const std::string& board_name) {
+  if (slot.count == 0) {
+    slot.feeder = feeder.name;
+    slot.feeder_kind = cell::kFeederKindNames[static_cast<std::size_t>(feeder.kind)];
+    slot.slot_kind = !feeder.is_pallet() ? "" : is_lane ? "lane" : "pocket";
+    slot.slot = k;
+    slot.pick = cell::PalletPickPoint(feeder.pick, feeder.pallet_last, feeder.pallet_back, feeder.columns,
+                                      feeder.rows, std::max(k, 1));
+    for (double& coordinate : slot.pick) coordinate = Round(coordinate, kCadResolutionMm);
+  }
+  ++slot.count;
+  // A lane or a single tape gives the same parts to every board: named once.
+  // A pocket holds one part of one board.
+  if (board == 0 || slot.slot_kind == "pocket") {
+    slot.designators.push_back(board == 0 ? Printable(part.designator)
+                                          : fmt::format("{} ({})", Printable(part.designator), board_name));
+  }
+  for (auto [field, seen] : {std::pair{&part.value, &slot.values}, std::pair{&part.package, &slot.packages}}) {
+    if (!field->empty() && std::find(seen->begin(), seen->end(), *field) == seen->end()) seen->push_back(*field);
+  }
+}
+
 std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   summary_.rows_read = reader.rows_read();
   summary_.rows_with_errors = reader.rows_with_errors();
-  summary_.skipped[static_cast<int>(SkipReason::kNoDesignator)] = reader.rows_without_designator();
   summary_.format = fmt::format("{}, {}", cad::FormatTitle(reader.format()), cad::UnitName(reader.unit()));
   summary_.encoding = options_.encoding;
   if (options_.encoding != cad::TextEncoding::kUtf8) {
@@ -419,6 +548,7 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
     if (on_side[s]++ == 0) first_on_side[s] = &part;
   }
   cad::Side side = options_.side.value_or(on_side[1] > 0 && on_side[0] == 0 ? cad::Side::kBottom : cad::Side::kTop);
+  summary_.placed_side = side;
   if (!options_.side && on_side[0] > 0 && on_side[1] > 0) {
     int minority = on_side[1] <= on_side[0] ? 1 : 0;
     diags_.Report(DiagKind::ImportMixedSides, first_on_side[minority]->side_range, on_side[0], on_side[1]);
@@ -429,10 +559,10 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
   std::vector<const Part*> placed, unmapped;
   for (const Part& part : parts_) {
     if (part.side != side || part.skip) {
-      ReportSkip(part, side);
+      Skip(part, side);
     } else if (!part.feeder) {
       if (options_.skip_unmapped) {
-        ReportSkip(part, side);
+        Skip(part, side);
       } else {
         unmapped.push_back(&part);
       }
@@ -440,6 +570,23 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
       placed.push_back(&part);
     }
   }
+  if (!reader.lines_without_designator().empty()) {
+    SkipGroup group{SkipReason::kNoDesignator, "without a designator (--skip-empty-designators)", {}};
+    for (std::uint32_t line : reader.lines_without_designator()) {
+      group.names.push_back(fmt::format("line {}", line));
+      if (options_.keep_fates) {
+        RowFate fate;
+        fate.row.line = line;
+        fate.reason = SkipReason::kNoDesignator;
+        fate.why = group.why;
+        fates_.push_back(std::move(fate));
+      }
+    }
+    summary_.skipped[static_cast<int>(SkipReason::kNoDesignator)] = group.names.size();
+    summary_.skip_groups.push_back(std::move(group));
+    group_first_.push_back(nullptr);
+  }
+  ReportSkipGroups(side);
   summary_.parts_placed = placed.size();
   if (!unmapped.empty()) {
     ReportUnmapped(unmapped);
@@ -458,15 +605,40 @@ std::optional<ir::Program> CadImporter::Finish(const cad::ListReader& reader) {
     summary_.failed = true;
     return std::nullopt;
   }
+  // The program's size is asked for by the list and the panel together:
+  // bounded before it is built (calibration/limits.h).
+  const double placements = static_cast<double>(placed.size()) * static_cast<double>(summary_.boards);
+  if (placements > static_cast<double>(limits::kMaxImportedPlacements)) {
+    diags_.Report(DiagKind::ImportTooManyPlacements, SourceRange(SourceLoc{list_file_, 0, 0}), placed.size(),
+                  options_.columns, options_.rows, fmt::format("{:.0f}", placements), limits::kMaxImportedPlacements);
+    summary_.failed = true;
+    return std::nullopt;
+  }
+  // How the list writes bottom x matters for the bottom side's placements
+  // and, either side, for the outline the parts span.
   cad::BottomPositions bottom_positions = cad::BottomPositions::kTopView;
-  if (side == cad::Side::kBottom) bottom_positions = DescribeBottom(reader);
+  if (side == cad::Side::kBottom) {
+    bottom_positions = DescribeBottom(reader);
+  } else if (on_side[1] > 0 || options_.bottom_positions) {
+    bottom_positions = options_.bottom_positions.value_or(DecideBottom(reader).positions);
+  }
   std::optional<ir::Program> program = Build(placed, side, bottom_positions);
   std::vector<Part>().swap(parts_);  // the program holds what it needs; free the rows before printing
+  if (options_.keep_fates) {
+    std::stable_sort(fates_.begin(), fates_.end(), [](const RowFate& a, const RowFate& b) { return a.row.line < b.row.line; });
+  }
   if (!program || diags_.has_errors()) {
     summary_.failed = true;
     return std::nullopt;
   }
   return program;
+}
+
+cad::BottomDecision CadImporter::DecideBottom(const cad::ListReader& reader) const {
+  std::vector<cad::SidedX> sided;
+  sided.reserve(parts_.size());
+  for (const Part& part : parts_) sided.push_back({part.x_mm, part.side});
+  return cad::DecideBottomPositions(reader, sided);
 }
 
 cad::BottomPositions CadImporter::DescribeBottom(const cad::ListReader& reader) {
@@ -476,10 +648,7 @@ cad::BottomPositions CadImporter::DescribeBottom(const cad::ListReader& reader) 
     positions = *options_.bottom_positions;
     why = "as --bottom-positions says";
   } else {
-    std::vector<cad::SidedX> sided;
-    sided.reserve(parts_.size());
-    for (const Part& part : parts_) sided.push_back({part.x_mm, part.side});
-    cad::BottomDecision decision = cad::DecideBottomPositions(reader, sided);
+    cad::BottomDecision decision = DecideBottom(reader);
     positions = decision.positions;
     why = decision.why;
   }
@@ -502,20 +671,69 @@ cad::BottomPositions CadImporter::DescribeBottom(const cad::ListReader& reader) 
   return positions;
 }
 
-void CadImporter::PlaceOnSpot(const std::vector<std::array<double, 2>>& on_board, double angle) {
-  // The parts of the whole panel in the panel's own axes: board (c, r) is
-  // (c * pitch_x, r * pitch_y) from the first.
-  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
-  for (const auto& [x, y] : on_board) {
-    lo_x = std::min(lo_x, x);
-    hi_x = std::max(hi_x, x + (options_.columns - 1) * options_.pitch_x_mm);
-    lo_y = std::min(lo_y, y);
-    hi_y = std::max(hi_y, y + (options_.rows - 1) * options_.pitch_y_mm);
+std::array<double, 4> CadImporter::Outline(cad::BottomPositions bottom_positions) const {
+  if (options_.board) return *options_.board;
+  // Every part the list gives, of both sides, seen from the top: fiducials
+  // and parts left out mark the board as well as the parts placed.
+  const double inf = std::numeric_limits<double>::infinity();
+  std::array<double, 4> box = {inf, inf, -inf, -inf};
+  for (const Part& part : parts_) {
+    const double x = part.side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX
+                         ? -part.x_mm
+                         : part.x_mm;
+    box = {std::min(box[0], x), std::min(box[1], part.y_mm), std::max(box[2], x), std::max(box[3], part.y_mm)};
   }
-  const double cx = (lo_x + hi_x) / 2, cy = (lo_y + hi_y) / 2;
-  const auto [spot_x, spot_y] = *options_.centre_spot;
-  options_.origin_x_mm = Round(spot_x - (std::cos(angle) * cx - std::sin(angle) * cy), kCadResolutionMm);
-  options_.origin_y_mm = Round(spot_y - (std::sin(angle) * cx + std::cos(angle) * cy), kCadResolutionMm);
+  return box;
+}
+
+bool CadImporter::PlaceBoard(const std::array<double, 4>& outline, double angle) {
+  // The whole panel in the panel's own axes: board (c, r) is (c * pitch_x,
+  // r * pitch_y) from the first.
+  const double span_x = (options_.columns - 1) * options_.pitch_x_mm, span_y = (options_.rows - 1) * options_.pitch_y_mm;
+  const double lo_x = outline[0] + std::min(0.0, span_x), hi_x = outline[2] + std::max(0.0, span_x);
+  const double lo_y = outline[1] + std::min(0.0, span_y), hi_y = outline[3] + std::max(0.0, span_y);
+  const double c = std::cos(angle), s = std::sin(angle);
+  auto turned = [&](double x, double y) { return std::array<double, 2>{c * x - s * y, s * x + c * y}; };
+  const bool panel = options_.columns * options_.rows > 1;
+  if (options_.pocket) {
+    // The panel's corners turned into the fixture's axes; their lower left
+    // goes to the pocket's lower left corner.
+    double min_x = std::numeric_limits<double>::infinity(), min_y = min_x, max_x = -min_x, max_y = -min_x;
+    for (double x : {lo_x, hi_x}) {
+      for (double y : {lo_y, hi_y}) {
+        const auto [tx, ty] = turned(x, y);
+        min_x = std::min(min_x, tx);
+        min_y = std::min(min_y, ty);
+        max_x = std::max(max_x, tx);
+        max_y = std::max(max_y, ty);
+      }
+    }
+    const auto [px0, py0, px1, py1] = *options_.pocket;
+    options_.origin_x_mm = Round(px0 - min_x, kCadResolutionMm);
+    options_.origin_y_mm = Round(py0 - min_y, kCadResolutionMm);
+    summary_.origin_how = fmt::format("the {}'s lower left corner in the pocket of fixture {} (pocket_x_mm, pocket_y_mm)",
+                                      panel ? "panel" : "board", options_.fixture);
+    if (max_x - min_x > px1 - px0 + kCadResolutionMm || max_y - min_y > py1 - py0 + kCadResolutionMm) {
+      diags_.Report(DiagKind::ImportBoardOverPocket, options_.pocket_range, panel ? "panel" : "board",
+                    FormatLength(max_x - min_x), FormatLength(max_y - min_y), options_.fixture,
+                    FormatLength(px1 - px0), FormatLength(py1 - py0));
+      return false;
+    }
+    return true;
+  }
+  if (options_.centre_spot) {
+    const auto [cx, cy] = turned((lo_x + hi_x) / 2, (lo_y + hi_y) / 2);
+    const auto [spot_x, spot_y] = *options_.centre_spot;
+    options_.origin_x_mm = Round(spot_x - cx, kCadResolutionMm);
+    options_.origin_y_mm = Round(spot_y - cy, kCadResolutionMm);
+    summary_.origin_how = fmt::format("the {}'s centre on {} (--origin X,Y places it elsewhere)",
+                                      panel ? "panel" : "board", options_.centre_spot_name);
+    return true;
+  }
+  summary_.origin_how =
+      "the fixture has no pocket (pocket_x_mm, pocket_y_mm) and no calibrated region to centre the board on; "
+      "give --origin X,Y";
+  return true;
 }
 
 std::vector<std::unordered_map<std::size_t, int>> CadImporter::AssignTapeLanes(
@@ -581,22 +799,51 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
   const bool list_negated = side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX;
   std::vector<std::array<double, 2>> on_board(parts.size());
+  const std::array<double, 4> outline = Outline(bottom_positions);  // seen from the top
+  const bool outline_given = options_.board.has_value();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const double x_top = list_negated ? -parts[i]->x_mm : parts[i]->x_mm;  // the list's x as seen from the top
     const double x = mirror == ImportMirror::kX ? -x_top : x_top;
     const double y = mirror == ImportMirror::kY ? -parts[i]->y_mm : parts[i]->y_mm;
     on_board[i] = {x == 0 ? 0.0 : x, y == 0 ? 0.0 : y};
+    if (outline_given && (x_top < outline[0] - kCadResolutionMm || x_top > outline[2] + kCadResolutionMm ||
+                          parts[i]->y_mm < outline[1] - kCadResolutionMm || parts[i]->y_mm > outline[3] + kCadResolutionMm)) {
+      diags_.Report(DiagKind::ImportPartOffBoard, parts[i]->designator_range, Printable(parts[i]->designator),
+                    FormatLength(x_top), FormatLength(parts[i]->y_mm), FormatLength(outline[0]),
+                    FormatLength(outline[2]), FormatLength(outline[1]), FormatLength(outline[3]));
+    }
   }
+  summary_.outline = fmt::format("x {}..{}, y {}..{} mm{}", FormatLength(outline[0]), FormatLength(outline[2]),
+                                 FormatLength(outline[1]), FormatLength(outline[3]),
+                                 outline_given ? " (--board)" : ", the parts' bounding box (no --board)");
 
   // --- the boards of the panel, row by row from the origin --------------
+  // The outline on the board as placed: turned over with the parts, so the
+  // bottom side turns about the board's own edge and lands where its top did.
+  std::array<double, 4> placed_outline = outline;
+  if (mirror == ImportMirror::kX) placed_outline = {-outline[2], outline[1], -outline[0], outline[3]};
+  if (mirror == ImportMirror::kY) placed_outline = {outline[0], -outline[3], outline[2], -outline[1]};
   const double angle = options_.rotation_deg * std::numbers::pi / 180.0;
-  if (!options_.origin_given && options_.centre_spot) PlaceOnSpot(on_board, angle);
+  if (options_.origin_given) {
+    summary_.origin_how = "--origin";
+  } else {
+    if (!PlaceBoard(placed_outline, angle)) return std::nullopt;
+    if (!outline_given && (options_.pocket || options_.centre_spot)) {
+      diags_.Report(DiagKind::ImportOutlineFromParts, SourceRange(SourceLoc{list_file_, 0, 0}),
+                    FormatLength(outline[0]), FormatLength(outline[2]), FormatLength(outline[1]),
+                    FormatLength(outline[3]));
+    }
+  }
   summary_.origin_x_mm = options_.origin_x_mm;
   summary_.origin_y_mm = options_.origin_y_mm;
   std::vector<std::string> boards;
   std::string board_text = fmt::format("origin ({}, {}) mm, rotated {}°", options_.origin_x_mm, options_.origin_y_mm,
                                        options_.rotation_deg);
-  if (!options_.origin_given && options_.centre_spot) board_text += ", its parts centred on " + options_.centre_spot_name;
+  if (!options_.origin_given && options_.pocket) {
+    board_text += ", its outline in the fixture's pocket";
+  } else if (!options_.origin_given && options_.centre_spot) {
+    board_text += ", its outline centred on " + options_.centre_spot_name;
+  }
   const bool panel = options_.columns * options_.rows > 1;
   items.push_back(CommentStmt(
       start,
@@ -705,6 +952,12 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       double theta = part.rotation_deg;
       if (mirror_rotation) theta = mirror == ImportMirror::kX ? 180.0 - theta : -theta;
       double u = NormaliseAngle(theta + part.feeder->rotation_offset_deg, options_.angles);
+      if (b == 0 && options_.keep_fates) {
+        RowFate& fate = fates_[FateIndex(part)];
+        fate.placed = true;
+        fate.point = name;
+        fate.board_xyu = {x, y, u};
+      }
       ir::PointDecl point{std::move(name), loc, false,
                           MakeCoords(loc, {x, y, options_.place_z_mm, u}), boards[b], loc};
       items.push_back(MakeStmt(loc, std::move(point), comments[i]));
@@ -717,9 +970,11 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   cycle.fixture_loc = start;
   cycle.end.loc = start;
   std::vector<int> pockets_used(feeders.size(), 0);
+  setup_ = SetupSheet{options_.program_name, options_.fixture, boards.size(), {}, {}};
   for (std::size_t f = 0; f < feeders.size(); ++f) {
     if (by_feeder[f].empty()) continue;
     const cad::FeederSpec& feeder = feeders[f];
+    std::map<int, SetupSlot> slots;  // by lane or pocket (0: the single pick point)
     std::size_t count = by_feeder[f].size() * boards.size();
     cycle.body.push_back(CommentStmt(start,
                                      fmt::format("feeder {}: {} placement{}", feeder.name, count, count == 1 ? "" : "s"),
@@ -732,12 +987,14 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         std::string pick_comment;
         pick.kind = ir::PickPlaceKind::Pick;
         pick.target.loc = loc;
+        int slot = 0;
+        bool is_lane = false;
         if (!feeder.is_pallet()) {
           pick.target.base = ir::NamedPoint{pick_name[f], static_cast<std::uint32_t>(pick_name[f].size())};
         } else {
           int k = part->feeder->lane.value_or(0);
           if (auto lane = tape_lane[f].find(i); k == 0 && lane != tape_lane[f].end()) k = lane->second;
-          const bool is_lane = k != 0;
+          is_lane = k != 0;
           if (k == 0) {
             k = ++pockets_used[f];
             if (k == feeder.pick_points() + 1) {
@@ -748,6 +1005,14 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
           }
           pick.target.base = ir::PalletPoint{IntLit(loc, std::max(pallet_number[f], 0)), IntLit(loc, k), nullptr};
           pick_comment = is_lane ? fmt::format(" lane {}", k) : fmt::format(" pocket {} of {}", k, feeder.pick_points());
+          slot = k;
+        }
+        AddToSetup(slots[slot], feeder, slot, is_lane, *part, b, boards[b]);
+        if (b == 0 && options_.keep_fates) {
+          RowFate& fate = fates_[FateIndex(*part)];
+          fate.feeder = feeder.name;
+          fate.slot_kind = !feeder.is_pallet() ? "" : is_lane ? "lane" : "pocket";
+          fate.slot = slot;
         }
         cycle.body.push_back(MakeStmt(loc, std::move(pick), pick_comment));
         ir::PickPlace place;
@@ -757,6 +1022,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         cycle.body.push_back(MakeStmt(loc, std::move(place), comments[i]));
       }
     }
+    for (auto& [k, slot] : slots) setup_.slots.push_back(std::move(slot));
   }
   ir::Function main;
   main.name = "Main";

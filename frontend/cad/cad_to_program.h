@@ -25,6 +25,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -32,6 +33,7 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "frontend/cad/cad_bottom.h"
 #include "frontend/cad/cad_reader.h"
 #include "frontend/cad/cad_row.h"
 #include "frontend/feeders_toml.h"
@@ -62,6 +64,18 @@ struct ImportOptions {
   // the largest calibrated region on the fixture), or, without one, the
   // origin is (0, 0); the summary says which.
   bool origin_given = true;
+  // The board's outline in the list's coordinates seen from the top (x0, y0,
+  // x1, y1; --board). nullopt: the list gives none, so the bounding box of
+  // the list's parts (both sides) stands for it, with a warning when it
+  // decides where the board goes. A part outside a given outline is an error.
+  std::optional<std::array<double, 4>> board;
+  // The fixture's pocket for the board (the cell's pocket_x_mm, pocket_y_mm:
+  // x lo, y lo, x hi, y hi in the fixture frame). Without --origin the
+  // board's outline, turned over for the bottom side and turned by
+  // rotation_deg, goes into its lower left corner, so both sides of one
+  // board use the same pocket.
+  std::optional<std::array<double, 4>> pocket;
+  SourceRange pocket_range;  // the pocket's keys in the cell
   std::optional<std::array<double, 2>> centre_spot;
   std::string centre_spot_name;  // "region 'layer1'", for the program and the summary
   double rotation_deg = 0;  // the board's x axis against the fixture's
@@ -80,11 +94,66 @@ struct ImportOptions {
   std::string program_name;  // a valid name; the Program line
   std::string fixture;       // the cell fixture the board is on
   std::vector<std::string> header_lines;  // comment lines opening the program (what was imported, how)
+  bool keep_fates = false;  // keep every row's fate for the import report (--report)
 };
 
 // Why rows were not placed.
 enum class SkipReason { kOtherSide, kDnp, kExcluded, kUnmapped, kNoDesignator, kCount };
 std::string_view SkipReasonName(SkipReason reason);
+
+// Rows skipped for one reason and one rule: "no feeder holds package
+// 'C_0402_1005Metric', value '100n'" and every designator it left out.
+struct SkipGroup {
+  SkipReason reason = SkipReason::kUnmapped;
+  std::string why;                 // the rule, for the summary
+  std::vector<std::string> names;  // designators as the list writes them (printable); "line N" without one
+};
+
+// What became of one row of the list (the import report, --report).
+struct RowFate {
+  cad::Row row;  // as the list writes it (only its line for a row without a designator)
+  bool placed = false;
+  SkipReason reason = SkipReason::kCount;  // when skipped
+  std::string why;                         // when skipped: the rule
+  // When placed: the feeder, its lane or pocket (0: its single pick point),
+  // and the point in the program (on the first board of a panel) with its
+  // board coordinates.
+  std::string feeder;
+  std::string slot_kind;  // "lane", "pocket" or ""
+  int slot = 0;
+  std::string point;
+  std::array<double, 3> board_xyu{};  // x, y mm, u deg in the board's Local
+};
+
+// The feeder set-up sheet: which part goes in which feeder, lane or pocket.
+// `smtcal import` fills it from the list; `smtcal setup-sheet` from a
+// program's compile trace (backend/reports/setup_sheet.h, which prints both
+// as text and CSV).
+struct SetupSlot {
+  std::string feeder;       // "?" for picks the sheet cannot place at a feeder (see note)
+  std::string feeder_kind;  // "tape" or "tray"
+  std::string slot_kind;    // "lane", "pocket" or "" (the feeder's single pick point)
+  int slot = 0;
+  std::array<double, 4> pick{};              // the pick point, robot base frame
+  bool pick_known = true;                    // false: a Pick whose position only the run knows
+  // The parts taken from it, in the order they are placed: designators
+  // (first board of a panel; a pocket's part on a later board with it), or a
+  // program's place targets as written ("R1 + X(dx) ×3" when placed 3 times).
+  std::vector<std::string> designators;
+  // What it holds: from the list (import: the distinct ones, in order of
+  // appearance), or from the cell's feeder (a program: its package(s), the
+  // lane's own on a bank with one package per lane, and its value).
+  std::vector<std::string> values, packages;
+  std::size_t count = 0;  // picks per cycle (all boards of a panel)
+  std::string note;       // why a row is special ("" for most)
+};
+struct SetupSheet {
+  std::string program;  // the program's name
+  std::string fixture;  // the fixture(s) its cycles are on
+  std::size_t boards = 1;
+  std::string from;     // what the counts are of: "" for an import
+  std::vector<SetupSlot> slots;  // feeder by feeder in the feeder order, slots ascending
+};
 
 struct ImportSummary {
   std::size_t rows_read = 0;
@@ -95,6 +164,16 @@ struct ImportSummary {
   double origin_y_mm = 0;
   std::size_t feeders_used = 0;
   std::array<std::size_t, static_cast<int>(SkipReason::kCount)> skipped{};
+  // Every skipped row, grouped by reason and rule, in the order of the
+  // reasons and then of first appearance; the other side's rows are one
+  // group that the summary prints as one line.
+  std::vector<SkipGroup> skip_groups;
+  cad::Side placed_side = cad::Side::kTop;
+  // The board: its outline (list coordinates seen from the top) and how it
+  // was found, and how its origin was chosen; empty when the import failed
+  // before.
+  std::string outline;  // "x 0..16.6, y 0..40.1 mm (--board)"
+  std::string origin_how;  // "the board's lower left corner in the pocket of fixture Board (pocket_x_mm, pocket_y_mm)"
   std::string format;  // "KiCad CSV, mm" (", Windows-1252 text" when it was decoded)
   cad::TextEncoding encoding = cad::TextEncoding::kUtf8;
   // How the bottom side was read, when it is placed: "x negated in the list
@@ -121,6 +200,10 @@ class CadImporter {
   std::optional<ir::Program> Finish(const cad::ListReader& reader);
 
   const ImportSummary& summary() const { return summary_; }
+  // Every row's fate in list order (with ImportOptions::keep_fates), and the
+  // set-up sheet (after a successful Finish).
+  const std::vector<RowFate>& fates() const { return fates_; }
+  const SetupSheet& setup_sheet() const { return setup_; }
 
  private:
   struct Part {
@@ -144,15 +227,28 @@ class CadImporter {
 
   bool Classify(const cad::Row& row, Part& part);
   std::optional<cad::FeederMatch> FindFeeder(const cad::Row& row);
-  void ReportSkip(const Part& part, cad::Side placed_side);
+  // Files a skipped row under its reason and rule (one warning per group, at
+  // its first row, comes from ReportSkipGroups).
+  void Skip(const Part& part, cad::Side placed_side);
+  void ReportSkipGroups(cad::Side placed_side);
   void ReportUnmapped(const std::vector<const Part*>& unmapped);
   // How the bottom side is read (option or cad_bottom.h); fills summary_.bottom.
   cad::BottomPositions DescribeBottom(const cad::ListReader& reader);
+  cad::BottomDecision DecideBottom(const cad::ListReader& reader) const;
+  std::size_t FateIndex(const Part& part) const;  // the part's index in parts_ and fates_
+  // Adds a part (on board `board` of the panel) to its feeder slot of the set-up sheet.
+  void AddToSetup(SetupSlot& slot, const cad::FeederSpec& feeder, int k, bool is_lane, const Part& part,
+                  std::size_t board, const std::string& board_name);
   // Tapes hold one kind of part (package and value): per feeder, the lane
   // of each part (by index into `parts`) of a bank of tapes; warns about a
   // single tape given several kinds.
-  // Sets the origin so the parts' centre lands on options_.centre_spot.
-  void PlaceOnSpot(const std::vector<std::array<double, 2>>& on_board, double angle);
+  // The board's outline in the list's coordinates seen from the top: --board,
+  // or the bounding box of every part the list gives (both sides).
+  std::array<double, 4> Outline(cad::BottomPositions bottom_positions) const;
+  // Sets the origin from the outline (on board coordinates, turned over for
+  // the bottom side): into the pocket, or its centre on the centre spot.
+  // False after reporting a board that does not fit its pocket.
+  bool PlaceBoard(const std::array<double, 4>& on_board_outline, double angle);
   std::vector<std::unordered_map<std::size_t, int>> AssignTapeLanes(
       const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder);
   std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side,
@@ -167,6 +263,11 @@ class CadImporter {
   std::unordered_map<std::string, std::optional<cad::FeederMatch>> feeder_cache_;
   std::string cache_key_;
   std::vector<std::array<std::string, 4>> skip_details_;  // what the skip warnings say
+  std::map<std::pair<int, std::string>, std::size_t> group_of_;  // (reason, rule) -> index into summary_.skip_groups
+  std::vector<const Part*> group_first_;  // per group: its first row
+  std::vector<std::size_t> fate_of_part_;  // per parts_ index: index into fates_ (keep_fates)
+  std::vector<RowFate> fates_;
+  SetupSheet setup_;
   ImportSummary summary_;
 };
 

@@ -71,11 +71,7 @@ class Bind final : public Pass {
       diags.Report(DiagKind::FixtureNotInCell, sema::NameAt(decl.name_loc, decl.name), decl.name, cell.path, hint);
       return;
     }
-    FixtureBinding binding;
-    binding.name = decl.name;
-    binding.decl = &stmt;
-    binding.cell_fixture = fixture;
-    binding.nominal = PoseMatrix(fixture->origin_mm.x(), fixture->origin_mm.y(), 0, fixture->angle_deg);
+    FixtureBinding binding = NominalBinding(stmt, decl, *fixture);
     if (!fixture->teach_trips_mm.empty()) {
       TeachPose pose = EstimateTeachPose(*fixture, cell);
       if (pose.fix) binding.fix0 = *pose.fix;

@@ -1,6 +1,7 @@
 // Helpers of the compile state (passes/correction/compile_state.h).
 #include "passes/correction/compile_state.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "ir/symbols.h"
@@ -15,6 +16,28 @@ std::string_view CorrectionKindName(CorrectionKind kind) {
     case CorrectionKind::kUncorrected: return "uncorrected";
   }
   return "?";
+}
+
+std::unordered_map<const ir::Stmt*, bool> BaseStatementsCommandedAsWritten(const std::vector<Target>& targets) {
+  std::unordered_map<const ir::Stmt*, bool> as_written;
+  as_written.reserve(static_cast<std::size_t>(
+      std::count_if(targets.begin(), targets.end(), [](const Target& t) { return t.fixture < 0; })));
+  for (const Target& target : targets) {
+    if (target.fixture >= 0) continue;
+    // The first position counts when it is known; a second one never does.
+    auto [it, first] = as_written.emplace(target.stmt, target.known);
+    if (!first) it->second = false;
+  }
+  return as_written;
+}
+
+FixtureBinding NominalBinding(const ir::Stmt& stmt, const ir::FixtureDecl& decl, const cell::Fixture& fixture) {
+  FixtureBinding binding;
+  binding.name = decl.name;
+  binding.decl = &stmt;
+  binding.cell_fixture = &fixture;
+  binding.nominal = PoseMatrix(fixture.origin_mm.x(), fixture.origin_mm.y(), 0, fixture.angle_deg);
+  return binding;
 }
 
 bool Target::is_placement() const {

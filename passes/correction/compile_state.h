@@ -47,6 +47,10 @@ struct FixtureBinding {
   std::string teach_fault;                 // why the teach-time scan gave no FIX_0
 };
 
+// A program's `Fixture NAME` bound to the cell's fixture of that name at its
+// nominal pose, without the teach-time scan.
+FixtureBinding NominalBinding(const ir::Stmt& stmt, const ir::FixtureDecl& decl, const cell::Fixture& fixture);
+
 // FIX_0 from a fixture's teach-time scan (calibration/fixture_estimation.h does the
 // math), or the fault that stopped it.
 struct TeachPose {
@@ -148,6 +152,11 @@ struct CompileState {
   std::map<const ir::Stmt*, std::vector<TraceEvent>> cycle_traces;
   std::vector<CycleEstimate> cycles;
   bool trace_complete = true;  // false: the run hit its step limit (reported)
+  // false: verify sets every target's budget but reports no BudgetOverTolerance
+  // or FixtureBudgetUnbounded (simulate measures what the budget predicts and
+  // counts the findings from the targets; reported, they could fill the
+  // error limit and stop it)
+  bool report_budget_findings = true;
 
   int FindFixture(std::string_view name) const;  // index or -1, case-insensitive
   // The one copy of `text` this compile keeps.
@@ -171,6 +180,15 @@ struct CompileState {
   const std::vector<Eigen::Vector2d>& RegionTableNoiseOnce() const;
   mutable std::vector<Eigen::Vector2d> region_table_se_;
 };
+
+// Which base-frame statements the compiler commands as written: those whose
+// every target the compile-time run found is one known position (static,
+// or uncorrected outside every region); the others are corrected on the
+// controller. Keyed by every statement with a base-frame target (fixture
+// targets are left out: a CAD-sized program's million of them need no map).
+// The regions pass decides a target's kind by it, and so does `smtcal diff`
+// when it reads a compiled program back.
+std::unordered_map<const ir::Stmt*, bool> BaseStatementsCommandedAsWritten(const std::vector<Target>& targets);
 
 // The base-frame position of a fixture-frame pose through FIX.
 Pose4 PoseToBase(const Eigen::Affine3d& fix, const Pose4& in_fixture);

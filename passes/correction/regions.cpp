@@ -47,34 +47,14 @@ class Regions final : public Pass {
     for (const cell::Region& region : cell.regions) CheckDifficulty(region, diags);
 
     // A base-frame statement is static only when it has one known position.
-    // Counted only for statements with a base-frame target (a statement can
-    // have fixture targets too: Pallet(n, ...) with n known at run time):
-    // a CAD-sized program's million fixture targets need no map.
-    struct Positions {
-      int count = 0;
-      bool any_unknown = false;
-    };
-    std::unordered_map<const ir::Stmt*, Positions> positions;
-    positions.reserve(static_cast<std::size_t>(
-        std::count_if(state.targets.begin(), state.targets.end(), [](const Target& t) { return t.fixture < 0; })));
-    for (const Target& target : state.targets) {
-      if (target.fixture < 0) positions.emplace(target.stmt, Positions{});
-    }
-    for (const Target& target : state.targets) {
-      auto counted = positions.find(target.stmt);
-      if (counted == positions.end()) continue;
-      ++counted->second.count;
-      counted->second.any_unknown = counted->second.any_unknown || !target.known;
-    }
+    const std::unordered_map<const ir::Stmt*, bool> as_written = BaseStatementsCommandedAsWritten(state.targets);
     for (Target& target : state.targets) {
       std::string_view keyword = TargetKeyword(*target.stmt);
       SourceRange where = sema::StmtRange(*target.stmt);
       if (target.fixture >= 0) {
         target.kind = CorrectionKind::kFixture;
       } else {
-        const Positions& at = positions.find(target.stmt)->second;
-        bool single = at.count == 1 && !at.any_unknown;
-        target.kind = single ? CorrectionKind::kStatic : CorrectionKind::kRunTimeBase;
+        target.kind = as_written.at(target.stmt) ? CorrectionKind::kStatic : CorrectionKind::kRunTimeBase;
       }
       if (!target.known) {
         diags.Report(DiagKind::TargetPositionUnknown, where, keyword, target.text, target.unknown_because);
@@ -83,7 +63,7 @@ class Regions final : public Pass {
       target.required = RequiredPosition(target, state);
       target.region = cell.RegionAt(Xy(target.required));
       if (target.region != nullptr) continue;
-      std::string x = FormatMm(target.required[0]), y = FormatMm(target.required[1]);
+      std::string x = FormatComputedMm(target.required[0]), y = FormatComputedMm(target.required[1]);
       if (std::holds_alternative<ir::PickPlace>(target.stmt->node)) {
         diags.Report(DiagKind::TargetOutsideRegions, where, keyword, target.text, x, y, RegionList(cell));
       } else {

@@ -54,7 +54,7 @@ class StaticInversion final : public Pass {
                                             target.region->table_path)
                               : fmt::format("the solver stopped {} mm away", FormatMm(solution.residual_mm));
         diags.Report(DiagKind::StaticTargetNotInvertible, sema::StmtRange(*target.stmt), TargetKeyword(*target.stmt),
-                     target.text, FormatMm(target.required[0]), FormatMm(target.required[1]), target.region->name, why);
+                     target.text, FormatComputedMm(target.required[0]), FormatComputedMm(target.required[1]), target.region->name, why);
         continue;
       }
       if (target.kind == CorrectionKind::kStatic) Lower(target);

@@ -18,6 +18,8 @@
 
 #include <fmt/format.h>
 
+#include "calibration/motion_time.h"
+#include "calibration/scan_plan.h"
 #include "ir/constant_fold.h"
 #include "ir/symbols.h"
 #include "passes/correction/compile_state.h"
@@ -26,14 +28,6 @@
 namespace smtcal {
 
 namespace {
-
-// Time to move `distance` with a trapezoidal profile (triangular when short).
-double MoveTime(double distance, double speed, double accel) {
-  distance = std::abs(distance);
-  if (distance == 0 || speed <= 0 || accel <= 0) return 0;
-  if (distance < speed * speed / accel) return 2 * std::sqrt(distance / accel);
-  return distance / speed + speed / accel;
-}
 
 class VerifyTargets final : public Pass {
  public:
@@ -107,7 +101,7 @@ class VerifyTargets final : public Pass {
     if (worst == nullptr) return;
     std::string turn_text = worst_turn == 0 ? std::string() : fmt::format(" and turns {:+}°", worst_turn);
     diags.Report(DiagKind::FixtureShiftLeavesRegion, Where(target), TargetKeyword(*target.stmt), target.text,
-                 FormatMm(target.required[0]), FormatMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
+                 FormatComputedMm(target.required[0]), FormatComputedMm(target.required[1]), region.name, FormatMm(region.x_mm.lo),
                  FormatMm(region.x_mm.hi), FormatMm(region.y_mm.lo), FormatMm(region.y_mm.hi), binding.name,
                  fmt::format("{:.3f}", std::max(0.0, worst_shift)), worst->direction, turn_text,
                  FormatMm(fixture.max_shift_mm), FormatMm(fixture.max_rotation_deg));
@@ -142,10 +136,57 @@ class VerifyTargets final : public Pass {
     return text;
   }
 
+  // Which tables to measure at what pitch when the interpolation between
+  // their nodes takes too much of a budget: the target's own region and the
+  // regions under its fixture's trips. The part scales with the pitch
+  // squared; everything else stays.
+  static std::string InterpolationHint(const ErrorBudget& budget, const Target& target, const CompileState& state) {
+    const double part = budget[ErrorSource::kInterpolation].bound_mm;
+    const double own = target.region->interpolation.NormMm();
+    const double allowed = target.region->tolerance_mm - (target.budget_mm - part);
+    std::vector<const cell::Region*> regions = {target.region};
+    if (target.fixture >= 0) {
+      const FixtureErrorModel& model = state.ErrorModelFor(*state.fixtures[target.fixture].cell_fixture);
+      for (int r : model.trip_regions()) {
+        const cell::Region* region = r >= 0 ? &state.cell->regions[static_cast<std::size_t>(r)] : nullptr;
+        if (region != nullptr && std::find(regions.begin(), regions.end(), region) == regions.end()) {
+          regions.push_back(region);
+        }
+      }
+    }
+    std::string names;
+    double pitch = 0;
+    bool declared = false;
+    for (const cell::Region* region : regions) {
+      names += fmt::format("{}'{}'", names.empty() ? "" : ", ", region->name);
+      pitch = std::max(pitch, region->interpolation.PitchMm());
+      declared = declared || region->interpolation.Kind() == InterpolationKind::kDeclared;
+    }
+    const double new_pitch = PitchForShare(pitch, part, allowed);
+    const std::string through_trips =
+        target.fixture >= 0 ? fmt::format(" and {:.4f} mm more through the trips", part - own) : std::string();
+    std::string text = fmt::format(
+        "between the nodes of the table{} of region{} {} (largest pitch {} mm) the robot's error may depart from the "
+        "interpolation by {:.4f} mm here{}, {}; ",
+        regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", names, fmt::format("{:.1f}", pitch), own,
+        through_trips, InterpolationKindDescription(target.region->interpolation.Kind()));
+    text += new_pitch > 0 ? fmt::format("measure {} at a pitch of at most {:.1f} mm", regions.size() == 1 ? "it" : "them",
+                                        new_pitch)
+                          : std::string("no pitch fits while the other parts take the whole tolerance");
+    if (declared) {
+      text += fmt::format(", or measure check points at {} cell centres (docs/error-tables.md)",
+                          regions.size() == 1 ? "its" : "their");
+    }
+    return text;
+  }
+
   // What to do about the largest part of a budget.
-  static std::string BudgetHint(ErrorSource largest, const Target& target, const CompileState& state) {
+  static std::string BudgetHint(ErrorSource largest, const ErrorBudget& budget, const Target& target,
+                                const CompileState& state) {
     const cell::Fixture* fixture = target.fixture >= 0 ? state.fixtures[target.fixture].cell_fixture : nullptr;
     switch (largest) {
+      case ErrorSource::kInterpolation:
+        return InterpolationHint(budget, target, state);
       case ErrorSource::kUncalibratedTrips:
         return fmt::format("trips of fixture '{}' lie outside every calibrated table, so the robot's own error there "
                            "moves the whole board: calibrate a region under its markers (docs/cell.md)",
@@ -180,7 +221,7 @@ class VerifyTargets final : public Pass {
     target.budget_bounded = budget.bounded;
     target.budget_mm = total.BudgetMm();
     target.worst_case_mm = total.worst_mm;
-    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node)) return;
+    if (!std::holds_alternative<ir::PickPlace>(target.stmt->node) || !state.report_budget_findings) return;
     if (!budget.bounded) {
       if (!unbounded_reported.insert(target.fixture).second) return;
       const FixtureBinding& binding = state.fixtures[target.fixture];
@@ -198,7 +239,7 @@ class VerifyTargets final : public Pass {
                                     FormatMm(target.region->tolerance_mm), target.region->name,
                                     ErrorSourceDescription(largest),
                                     fmt::format("{:.4f}", budget[largest].BudgetMm()),
-                                    BudgetHint(largest, target, state));
+                                    BudgetHint(largest, budget, target, state));
     Diagnostics::AddNote(diag, Where(target), fmt::format("the budget's parts, each alone at 4 sigma (mm): {}",
                                                           BudgetParts(budget)));
   }
@@ -231,23 +272,32 @@ class VerifyTargets final : public Pass {
     return value ? value->value : robot.safe_limz_mm;
   }
 
-  // The marker scan: to each V path's start, then along it at the scan feed.
+  // The marker scan as the runtime drives it (calibration/scan_plan.h), from
+  // where the robot stands; it leaves the robot above the last path's end.
   static double ScanTime(const cell::Robot& robot, const FixtureBinding& binding, Position& at) {
-    const cell::Fixture& fixture = *binding.cell_fixture;
-    double seconds = 0;
-    for (const cell::ScanPath& path : fixture.scan_paths) {
-      std::vector<Pose4> points;
-      for (const cell::Point2& p : path.points) {
-        points.push_back(PoseToBase(binding.nominal, {p.x(), p.y(), fixture.scan_z_mm, 0}));
-      }
-      if (at.known) seconds += JumpTime(robot, at.pose, points.front(), robot.safe_limz_mm);
-      for (std::size_t i = 1; i < points.size(); ++i) {
-        double length = std::hypot(points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]);
-        seconds += fixture.scan_speed_mm_s > 0 ? length / fixture.scan_speed_mm_s : 0;
-      }
-      at = {points.back(), true};
+    std::optional<ScanPoint> from;
+    if (at.known) from = ScanPoint(at.pose[0], at.pose[1], at.pose[2]);
+    const ScanTiming timing = smtcal::ScanTime(robot, *binding.cell_fixture, from);
+    at = {{timing.end.x(), timing.end.y(), timing.end.z(), at.known ? at.pose[3] : 0.0}, true};
+    return timing.seconds;
+  }
+
+  // Where the robot is commanded for a target (base frame; a fixture
+  // target's at the fixture's nominal pose).
+  static const Pose4& Command(const Target& target) {
+    return target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+  }
+
+  // Where a cycle leaves the robot: its last known target. The cycle repeats,
+  // so the next one, and its scan, start there.
+  static Position CycleEnd(const CompileState& state, const std::vector<TraceEvent>& events) {
+    Position end;
+    for (const TraceEvent& event : events) {
+      if (event.kind != TraceEvent::Kind::kMotion) continue;
+      const Target& target = state.targets[event.target];
+      if (target.known) end = {Command(target), true};
     }
-    return seconds;
+    return end;
   }
 
   static void EstimateCycles(CompileState& state) {
@@ -258,7 +308,7 @@ class VerifyTargets final : public Pass {
       CycleEstimate estimate;
       estimate.cycle = stmt;
       estimate.fixture = cycle.fixture;
-      Position at;
+      Position at = CycleEnd(state, events);
       int fixture = state.FindFixture(cycle.fixture);
       if (fixture >= 0) estimate.scan_s = ScanTime(robot, state.fixtures[fixture], at);
       for (const TraceEvent& event : events) {
@@ -268,7 +318,7 @@ class VerifyTargets final : public Pass {
         }
         const Target& target = state.targets[event.target];
         if (!target.known) continue;
-        const Pose4& to = target.kind == CorrectionKind::kUncorrected ? target.required : target.nominal;
+        const Pose4& to = Command(target);
         bool jump = !std::holds_alternative<ir::Motion>(target.stmt->node) ||
                     std::get<ir::Motion>(target.stmt->node).kind == ir::MotionKind::Jump;
         if (at.known) {

@@ -1,15 +1,18 @@
 // smtcal diff of two generated programs of 1 M placements each
 // (program_generator.h; NEW has every 1000th point 2 µm further along x):
-// both parsed and checked, diffed with the paper cell's fixture poses, and
-// the text report made, as `smtcal diff OLD NEW --cell CELL` does. Counters:
-// the targets compared and moved, and the peak resident memory of the
-// benchmark alone (both program texts are part of it, twice each).
+// both parsed and checked, diffed as text, then compiled for the paper cell
+// (the correction passes that decide the commands) and compared on the
+// machine, and the text report made, as `smtcal diff OLD NEW --cell CELL`
+// does with two source programs. Counters: the targets compared and moved,
+// and the peak resident memory of the benchmark alone (both program texts
+// are part of it, twice each).
 #include <benchmark/benchmark.h>
 
 #include "backend/diff/diff_report.h"
 #include "backend/diff/program_diff.h"
 #include "frontend/cell_toml.h"
 #include "frontend/parse.h"
+#include "passes/machine_targets.h"
 #include "passes/pass_manager.h"
 #include "tests/bench/bench_support.h"
 #include "tests/bench/program_generator.h"
@@ -50,6 +53,13 @@ void BM_DiffPlacements(benchmark::State& state) {
     diff::DiffOptions options;
     options.cell = &*cell.value();
     diff::ProgramDiff result = diff::DiffPrograms(old_program, new_program, options, diags);
+    const MachineTargets old_targets = SourceProgramTargets(old_program, *cell.value(), diags);
+    const MachineTargets new_targets = SourceProgramTargets(new_program, *cell.value(), diags);
+    if (diags.has_errors()) {
+      state.SkipWithError("the generated programs do not compile for the paper cell");
+      break;
+    }
+    diff::CompareOnMachine(result, {&*cell.value(), &old_targets, {}}, {&*cell.value(), &new_targets, {}});
     std::string text = diff::FormatDiffText(result);
     summary = result.summary;
     report_bytes = text.size();

@@ -72,7 +72,7 @@ EXIT_COMMENT = re.compile(r"\s#\s*exit (\d+)\b[^#]*$")
 EXIT_MARK = re.compile(r"^\s*<!--\s*exit (\d+)\s*-->\s*$")
 PLACEHOLDER = re.compile(r"(?<![\w./-])(?:[A-Z][A-Z0-9_]*)(?:\.[A-Za-z0-9.]+)?(?![\w/-])"
                          r"|[\[\]]|\.\.\.|…|<[^>\s]+>|\w\|\w")
-OUTPUT_OPTIONS = {"-o", "--output", "--report", "--svg"}
+OUTPUT_OPTIONS = {"-o", "--output", "--report", "--svg", "--csv", "--setup-sheet", "--setup-csv"}
 PATH_LIKE = re.compile(r"/|\.(place|toml|csv|json|pos|txt|tsv|mnt|mnb|ngc|ini|svg)$")
 TIMEOUT_S = 300
 

@@ -8,6 +8,7 @@
 #include "backend/reports/table_report.h"
 #include "calibration/error_table_build.h"
 #include "calibration/error_table_check.h"
+#include "calibration/interpolation_error.h"
 #include "calibration/inverse_calibration.h"
 #include "frontend/table_csv.h"
 #include "tests/fuzz/fuzz_solve.h"
@@ -24,8 +25,13 @@ SMTCAL_FUZZ_TARGET(table_csv) {
   if (table && ValidateErrorTable(*table, diags, TableWarnings::kReport, &analysis)) {
     TableStats stats = ComputeTableStats(*table);
     int bound = IterationBound(analysis.contraction, analysis.max_abs_error_mm);
-    FormatStatsText(*table, stats, analysis, bound);
-    FormatStatsJson(*table, stats, analysis, bound);
+    // The interpolation error, with check points (when the table has any)
+    // and a declared roughness, and its grid advice.
+    const InterpolationEstimate interpolation =
+        EstimateInterpolationError(*table, DeclaredRoughness{0.25, 25}, 0.005);
+    ReportCoarseGrid(interpolation, kDefaultTableToleranceMm, "the table", interpolation.Origin(), diags);
+    FormatStatsText(*table, stats, analysis, bound, interpolation, kDefaultTableToleranceMm);
+    FormatStatsJson(*table, stats, analysis, bound, interpolation, kDefaultTableToleranceMm);
     PlotTableSvg(*table, "table.csv");
     FormatTableCsv(*table, {"fuzz"});
     const Rect domain = TableDomain(*table);

@@ -7,8 +7,8 @@
 //   suite runs over the seed corpus and every regression input, so each
 //   finding stays fixed in the ordinary and the sanitizer builds.
 // A harness aborts (a finding) on anything smtcal must never do: an escaping
-// exception, an internal check, a sanitizer report, or a broken property it
-// states itself (fmt's round trip).
+// exception, an internal check (which aborts here instead of exit 3), a
+// sanitizer report, or a broken property it states itself (fmt's round trip).
 #pragma once
 
 #include <cstddef>
@@ -19,7 +19,17 @@
 #include <string>
 #include <string_view>
 
+#include "base/check.h"
+
 namespace smtcal::fuzz {
+
+// A failed SMTCAL_CHECK ends smtcal with exit 3 (base/check.h); in a harness
+// it must be a crash that libFuzzer and the replay report as a finding, so
+// every harness asks for the abort before it runs.
+inline const bool kAbortOnInternalError = [] {
+  ::setenv(kAbortOnInternalErrorVariable, "1", 1);
+  return true;
+}();
 
 using FuzzFunction = int (*)(const std::uint8_t* data, std::size_t size);
 

@@ -33,7 +33,7 @@ fi
 dict_of() {
   case "$1" in
     place_check | fmt_roundtrip | compile) echo place ;;
-    table_csv | raw_csv | points_csv | trips_csv) echo csv ;;
+    table_csv | raw_csv | points_csv | trips_csv | text) echo csv ;;
     cell_toml | feeders_toml | truth_toml) echo toml ;;
     cad) echo cad ;;
     previous_json) echo json ;;

@@ -247,7 +247,7 @@ int Run(const Options& options) {
     const RobotScale scale = ScaleOf(cycle);
     const TripLatency past = CheckTrips(fixture, sensor, cycle["trips"], truth, scale);
     const json scan = ReadJson(cycle["scan"].get<std::string>());
-    const double speed = fixture.scan_speed_mm_s;
+    const double speed = fixture.TripLatchSpeedMmS();  // the feed that latches the trips
     // The sensor HAL's affine model of the tables is that far off at most.
     double model_error = 0;
     for (const SensorModel& model : sensor) model_error = std::max(model_error, model.max_error_mm);
@@ -340,9 +340,21 @@ int PrintSensorModels(const Options& options) {
     return 2;
   }
   const cell::Cell& cell = *loaded.value();
+  const cell::Fixture& fixture = cell.fixtures.at(0);
+  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   json out = json::array();
-  for (const SensorModel& model : SensorModels(cell, cell.fixtures.at(0))) {
-    out.push_back({{"m", {{model.m(0, 0), model.m(0, 1)}, {model.m(1, 0), model.m(1, 1)}}},
+  const std::vector<SensorModel> models = SensorModels(cell, fixture);
+  for (std::size_t path = 0; path < models.size(); ++path) {
+    const SensorModel& model = models[path];
+    // The marker the path scans: 1 for edges p1 and p2, 2 for p3 and p4
+    // (the sensor HAL's units per marker).
+    int marker = 0;
+    for (const ExpectedTrip& trip : expected) {
+      if (trip.path == path) marker = trip.edge < 2 ? 1 : 2;
+    }
+    out.push_back({{"path", fixture.scan_paths[path].name},
+                   {"marker", marker},
+                   {"m", {{model.m(0, 0), model.m(0, 1)}, {model.m(1, 0), model.m(1, 1)}}},
                    {"b", {model.b.x(), model.b.y()}},
                    {"max_error_mm", model.max_error_mm}});
   }

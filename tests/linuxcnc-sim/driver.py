@@ -23,7 +23,15 @@
 #            shows it: on = a Pick, off = a Place (M64/M65 wait until the
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
-#   messages every operator message (an abort is one).
+#   messages every operator message (an abort is one);
+#   trace    per cycle, the machine's position (x, y, z) at every status
+#            update that shows it changed, from the clamp to the cycle's
+#            first vacuum change: when the scan's first move began and
+#            when the first placement move left the scan (run_scenario.py
+#            measures the scan's overhead from it).
+# With $SMTCAL_SIM_REAL_PINS (a robot model's HAL component, run_measure.py)
+# every Place also records where the robot really was ("real": the model's
+# position latched in the servo thread when the valve went off).
 # Written to $SMTCAL_SIM_RUN (JSON) when the run ends.
 import json
 import os
@@ -45,11 +53,11 @@ def hal(commands):
 
 def place_board(pose, sensor_models):
     """The board's true pose for the sensor HAL (marker-sensor.hal): per
-    marker k, f = R(a)^T (M p + b - o) into sum2.(2k) and sum2.(2k+1), where
-    M p + b is where the robot really puts the sensor for a command p. A
-    robot whose scale the tables do not know (robot_scale_ppm about
-    robot_scale_about_mm, the monitor's scenario) puts it s (p - about)
-    farther: M + s I, b - s about."""
+    marker k (the models in marker order), f = R(a)^T (M p + b - o) into
+    sum2.(2k) and sum2.(2k+1), where M p + b is where the robot really puts
+    the sensor for a command p around that marker. A robot whose scale the
+    tables do not know (robot_scale_ppm about robot_scale_about_mm, the
+    monitor's scenario) puts it s (p - about) farther: M + s I, b - s about."""
     a = math.radians(pose["angle_deg"])
     c, s = math.cos(a), math.sin(a)
     o = (pose["x_mm"], pose["y_mm"])
@@ -72,6 +80,7 @@ def place_board(pose, sensor_models):
 
 def main():
     plan = json.load(open(os.environ["SMTCAL_SIM_PLAN"]))
+    real_pins = os.environ.get("SMTCAL_SIM_REAL_PINS", "")  # the robot model's component, when there is one
     out_path = os.environ["SMTCAL_SIM_RUN"]
     started = time.monotonic()
     record = {"cycles": [], "messages": [], "vacuum": [], "end": None, "times": {}}
@@ -95,6 +104,15 @@ def main():
         os.replace(out_path + ".tmp", out_path)
 
     stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+    reader = None
+    if real_pins:
+        import hal as hal_module
+        reader = hal_module.component("smtcal-sim-reader")
+        reader.newpin("x", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.newpin("y", hal_module.HAL_FLOAT, hal_module.HAL_IN)
+        reader.ready()
+        hal([f"net placed-x {real_pins}.x-latched => smtcal-sim-reader.x",
+             f"net placed-y {real_pins}.y-latched => smtcal-sim-reader.y"])
 
     def wait_for(predicate, what, timeout_s=30):
         end = time.monotonic() + timeout_s
@@ -141,6 +159,10 @@ def main():
         drain_messages()
         # A probe move's result: motion's latched position changes (the
         # tripped flag alone falls back when the next move starts).
+        if cycle is not None and "traced" not in cycle:
+            here = [round(v, 6) for v in stat.position[:3]]
+            if not cycle["trace"] or cycle["trace"][-1][1:] != here:
+                cycle["trace"].append([now()] + here)
         probe = tuple(stat.probed_position[:3])
         if probe != last_probe:
             last_probe = probe
@@ -154,7 +176,13 @@ def main():
             if out == VACUUM_OUT:
                 event = {"t": now(), "on": bool(stat.dout[out]), "position": list(stat.position[:6]),
                          "velocity": stat.current_vel, "cycle": len(record["cycles"]) - 1}
+                if reader is not None and not event["on"]:
+                    # Where the modelled robot really was when the valve went
+                    # off (latched in the servo thread by run_measure.py's model).
+                    event["real"] = [reader["x"], reader["y"]]
                 record["vacuum"].append(event)
+                if cycle is not None:
+                    cycle["traced"] = True  # the trace ends at the cycle's first Pick
             elif stat.dout[out] and clamped:
                 # The program released the board: this cycle is done.
                 hal(["sets transport-clamped false"])
@@ -174,7 +202,9 @@ def main():
             place_board(pose, plan["sensor_models"])
             hal(["sets transport-clamped true"])
             clamped = True
-            cycle = {"pose": pose, "clamped_s": now(), "probes": []}
+            stat.poll()
+            cycle = {"pose": pose, "clamped_s": now(), "probes": [],
+                     "trace": [[now()] + [round(v, 6) for v in stat.position[:3]]]}
             record["cycles"].append(cycle)
             next_cycle += 1
         time.sleep(0.001)

@@ -42,6 +42,7 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
@@ -66,25 +67,47 @@ def pose(dx=0.0, dy=0.0, turn_deg=0.0, present=True):
     return {"x_mm": ox, "y_mm": oy, "angle_deg": NOMINAL[2] + turn_deg, "present": present}
 
 
+def pose_s1(dx=0.0, dy=0.0, turn_deg=0.0):
+    """The board's true pose by its origin S1 (what the fixture's limits
+    bound): S1 shifted by (dx, dy), the board turned about it."""
+    return {"x_mm": NOMINAL[0] + dx, "y_mm": NOMINAL[1] + dy, "angle_deg": NOMINAL[2] + turn_deg, "present": True}
+
+
+def limit_corner(turn_deg, towards_deg, fraction=0.99):
+    """A board at a corner of the fixture's limits (max_shift_mm = 2,
+    max_rotation_deg = 0.5), times `fraction`: S1 shifted in the direction
+    `towards_deg` and the board turned about S1."""
+    a = math.radians(towards_deg)
+    return pose_s1(fraction * 2 * math.cos(a), fraction * 2 * math.sin(a), fraction * turn_deg)
+
+
+# Where a turn of the board about S1 moves marker 2 (its corner at (190, 90)
+# of the board): the shift that adds to it is the worst for the scan.
+MARKER2_DRIFT_DEG = math.degrees(math.atan2(190.0, -90.0))
+
 SIM = os.path.join(HERE, "sim.place")
 EXAMPLE_PROGRAM = os.path.join(SOURCE, "examples", "paper-cell", "layers.place")
+V_PATHS = os.path.join(HERE, "v-paths-fixture.toml")  # the scan before two stages: V paths at 12 mm/s
 
 # expect: "ok" (every cycle places), or the check the last cycle's scan fails.
-# The paper cell's V paths cross marker 2's edge p3 1 mm from its corner
-# (T8 at y 83 of the board, the corner at 82) and marker 1's p2 1 mm from
-# its corner (T4 at y 7): a board about 0.6 mm off in the wrong direction
-# already puts a trip on the wrong edge (line_residual). The good poses stay
-# inside that; the cycle_shift scenario needs a jump of more than
-# max_shift_mm = 2 mm between two boards the scan can still measure, so it
-# runs a copy of the cell held to 0.8 mm.
+# The example's scan paths measure every board its limits accept
+# (`smtcal cell check` states the capture range): boards at the corners of
+# the limits place, boards beyond them are refused by the pose checks.
 SCENARIOS = {
     "good_boards": {"program": SIM, "expect": "ok",
                     "cycles": [pose(0.3, -0.2, 0.1), pose(-0.6, 0.45, -0.2), pose(-0.2, 0.4, 0.25)]},
+    # The corners of the limits: S1 1.98 mm off, turned 0.495 deg; the first
+    # two move marker 2 the most (3.8 mm). A nominal board between two
+    # corners: the cycle checks hold the change between two boards to the
+    # same limits (two opposite corners are 3.96 mm apart: cycle_shift).
+    "limit_corners": {"program": SIM, "expect": "ok",
+                      "cycles": [limit_corner(0.5, MARKER2_DRIFT_DEG), pose_s1(),
+                                 limit_corner(-0.5, MARKER2_DRIFT_DEG + 180), pose_s1(),
+                                 limit_corner(0.5, -45), pose_s1(), limit_corner(-0.5, 135)]},
     "missing_board": {"program": SIM, "expect": "missing_trip", "cycles": [pose(present=False)]},
-    "shifted_board": {"program": SIM, "expect": "trip_window", "cycles": [pose(2.2, 0.0)]},
-    "rotated_board": {"program": SIM, "expect": "nominal_rotation", "cycles": [pose(turn_deg=-0.6)]},
-    "cycle_shift": {"program": SIM, "expect": "cycle_shift", "cell": {"max_shift_mm": 0.8},
-                    "cycles": [pose(-0.45, 0.3), pose(0.45, -0.3)]},
+    "shifted_board": {"program": SIM, "expect": "nominal_shift", "cycles": [pose_s1(1.45, 1.45)]},
+    "rotated_board": {"program": SIM, "expect": "nominal_rotation", "cycles": [pose_s1(turn_deg=-0.515)]},
+    "cycle_shift": {"program": SIM, "expect": "cycle_shift", "cycles": [pose_s1(-1.0, 0.6), pose_s1(1.0, -0.6)]},
     "cycle_rotation": {"program": SIM, "expect": "cycle_rotation",
                        "cycles": [pose(turn_deg=-0.3), pose(turn_deg=0.25)]},
     # The dry-run probe file (compile --dry-run-probe) first on the machine's
@@ -94,6 +117,25 @@ SCENARIOS = {
     # cycle, three boards.
     "example_three_boards": {"program": EXAMPLE_PROGRAM, "expect": "ok",
                              "cycles": [pose(0.4, -0.3, 0.15), pose(-0.5, 0.2, -0.25), pose(0.1, 0.3, 0.05)]},
+    # Opt-in: the scan before two stages (V paths, every trip latched at 12
+    # mm/s) and the example's, on the same boards (within the V paths' narrow
+    # capture), side by side: the overhead per cycle and the pose's error.
+    "scan_compare": {"program": SIM, "expect": "ok",
+                     "cycles": [pose(0.3, -0.2, 0.1), pose(-0.3, 0.2, -0.15), pose(0.1, 0.3, 0.05),
+                                pose(-0.2, -0.3, 0.2)],
+                     "variants": [{"name": "v-paths-12", "fixture": V_PATHS,
+                                   "what": "today's scan: V paths, one stage at 12 mm/s"},
+                                  {"name": "hairpins-40-8", "what": "the example: two stages, 40 and 8 mm/s"}]},
+    # Opt-in: the frontier of time against accuracy: the example's paths at
+    # other search and latch speeds.
+    "scan_frontier": {"program": SIM, "expect": "ok",
+                      "cycles": [pose(0.3, -0.2, 0.1), pose(-0.3, 0.2, -0.15), pose(0.1, 0.3, 0.05),
+                                 pose(-0.2, -0.3, 0.2)],
+                      "variants": [{"name": f"two-stages-{search}-{latch}", "what": f"search {search}, latch {latch} mm/s",
+                                    "cell": {"scan_speed_mm_s": search, "latch_speed_mm_s": latch}}
+                                   for search, latch in ((25, 4), (40, 4), (40, 8), (40, 12), (60, 8), (100, 12))]
+                      + [{"name": "one-stage-12", "what": "one stage at 12 mm/s",
+                          "cell": {"scan_speed_mm_s": 12, "latch_speed_mm_s": None}}]},
 }
 # The monitor (docs/monitor.md): a board that walks and a robot whose scale
 # between the markers drifts (the sensor HAL's gains; the checker lands the
@@ -133,9 +175,10 @@ SCENARIOS["monitor_drift_long"] = {"program": MONITOR, "expect": "ok", "cell_add
 SCENARIOS["record_overhead"] = {"program": SIM, "expect": "overhead", "cell_add": MONITOR_CELL, "cycles": [],
                                 "overhead_calls": 200}
 
-# Opt-in: the trip latency against the scan speed (one good board each).
+# Opt-in: the trip latency against the speed of one-stage probing (one good board each).
 for speed in (6, 12, 25, 50, 100):
-    SCENARIOS[f"latency_{speed}mm_s"] = {"program": SIM, "expect": "ok", "cell": {"scan_speed_mm_s": speed},
+    SCENARIOS[f"latency_{speed}mm_s"] = {"program": SIM, "expect": "ok",
+                                         "cell": {"scan_speed_mm_s": speed, "latch_speed_mm_s": None},
                                          "cycles": [pose(0.3, -0.2, 0.1)]}
 
 
@@ -177,8 +220,14 @@ def check_prerequisites():
 
 # ------------------------------------------------------------------ the machine
 
-def derive_ini(work, program_dir, dry_run):
-    """paper-cell.ini made headless, with the sensor HAL and the program's subroutines."""
+def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("marker-sensor.hal",)):
+    """paper-cell.ini made headless, with the sensor HAL, a runtime folder of
+    its own (`smtcal compile --ini` writes the runtime there) and then the
+    program's own subroutines (a program compiled without --ini, the
+    measuring programs; a folder that does not exist is skipped).
+    `display`: the DISPLAY program (a file of this folder); `extra_hals`: HAL
+    files loaded after the example's, in order (files of this folder, or
+    paths of files the scenario wrote into `work`)."""
     lines = open(os.path.join(EXAMPLE, "paper-cell.ini")).read().splitlines()
     out, section = [], ""
     for line in lines:
@@ -187,29 +236,31 @@ def derive_ini(work, program_dir, dry_run):
             section = stripped
         key = stripped.split("=", 1)[0].strip() if "=" in stripped and not stripped.startswith("#") else ""
         if section == "[DISPLAY]" and key == "DISPLAY":
-            line = "DISPLAY = " + os.path.join(work, "driver.py")
+            line = "DISPLAY = " + os.path.join(work, display)
         elif section == "[DISPLAY]" and key in ("INTRO_GRAPHIC", "INTRO_TIME"):
             continue  # popimage needs X
         elif section == "[RS274NGC]" and key == "SUBROUTINE_PATH":
-            line = "SUBROUTINE_PATH = " + os.path.join(program_dir, "subroutines")
+            line = "SUBROUTINE_PATH = " + os.path.join(work, "runtime") + ":" + os.path.join(program_dir, "subroutines")
             if dry_run:
                 line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
             # The cycle record's clock (#<_hal[smtcal-clock.out]>, marker-sensor.hal).
             line += "\nHAL_PIN_VARS = 1"
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
-            out.append("HALFILE = " + os.path.join(work, "marker-sensor.hal"))
+            for hal in extra_hals:
+                out.append("HALFILE = " + os.path.join(work, os.path.basename(hal)))
     ini = os.path.join(work, "sim.ini")
     # LinuxCNC reads nothing outside the scenario's folder (see work_root).
-    for name in ("driver.py", "marker-sensor.hal"):
-        shutil.copy(os.path.join(HERE, name), work)
+    for name in (display,) + tuple(extra_hals):
+        if not os.path.isabs(name) and os.path.exists(os.path.join(HERE, name)):
+            shutil.copy(os.path.join(HERE, name), work)
     open(ini, "w").write("\n".join(out) + "\n")
     for name in ("paper-cell.hal", "paper-cell.tbl", "paper-cell.var"):
         shutil.copy(os.path.join(EXAMPLE, name), work)
     return ini
 
 
-def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
+def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None, modules=None):
     tmp = os.path.join(work, "tmp")
     os.makedirs(tmp, exist_ok=True)
     os.chmod(tmp, 0o1777)  # rtapi_app binds its socket as RTAPI_UID
@@ -217,11 +268,16 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s):
     os.makedirs(home, exist_ok=True)
     env = dict(os.environ, RTAPI_UID="65534", RTAPI_FIFO_PATH="/tmp/rtapi_fifo", HOME=home,
                SMTCAL_SIM_PLAN=plan_path, SMTCAL_SIM_RUN=run_path)
+    env.update(extra_env or {})
     env.pop("DISPLAY", None)  # no X
     # Inside: a private /tmp (LinuxCNC's lock file and temporaries), then LinuxCNC.
+    # `modules`: a folder of realtime modules seen as LinuxCNC's own
+    # (rtapi_app loads only from /usr/lib/linuxcnc/modules), in this run only.
     inner = 'mount --bind "$0" /tmp && cd "$1" && exec linuxcnc -r "$2"'
+    if modules:
+        inner = 'mount --bind "$3" /usr/lib/linuxcnc/modules && ' + inner
     argv = ["timeout", "-k", "10", str(timeout_s + 60), "unshare", "--pid", "--fork", "--kill-child",
-            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini]
+            "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini, modules or ""]
     with open(os.path.join(work, "linuxcnc.log"), "w") as log_file:
         return subprocess.run(argv, env=env, stdout=log_file, stderr=subprocess.STDOUT).returncode
 
@@ -264,6 +320,25 @@ f.flush()
 """
 
 
+def run_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs):
+    """Runs LinuxCNC with its driver (start_linuxcnc; kwargs go there) and
+    returns the driver's record and the seconds LinuxCNC ran. Fails when a
+    process of the run outlives it or the driver left no record; skips
+    where LinuxCNC could not start."""
+    began = time.monotonic()
+    code = start_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs)
+    machine_s = time.monotonic() - began
+    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
+    if left:
+        fail("processes of the run outlived it: " + "; ".join(left))
+    if not os.path.exists(run_path):
+        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
+        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
+            skip("LinuxCNC could not start here:\n" + tail)
+        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
+    return json.load(open(run_path)), machine_s
+
+
 def work_root(path):
     """Where the scenarios run. LinuxCNC runs with a private /tmp bound over
     the system's, which hides everything below /tmp: a build under /tmp (a
@@ -286,8 +361,12 @@ def headless_example(args):
     for name in os.listdir(EXAMPLE):
         if name.startswith("paper-cell"):
             shutil.copy(os.path.join(EXAMPLE, name), work)
-    compiled = smtcal(["compile", EXAMPLE_PROGRAM, "--cell", CELL, "--target", "linuxcnc", "-o",
-                       os.path.join(work, "layers")], args.smtcal)
+    # As examples/linuxcnc/README.md says: compiled against the machine's INI,
+    # which is checked against the cell; the runtime goes where its
+    # SUBROUTINE_PATH says.
+    compiled = smtcal(["compile", EXAMPLE_PROGRAM, "--cell", CELL, "--target", "linuxcnc", "--ini",
+                       os.path.join(work, "paper-cell-headless.ini"), "-o", os.path.join(work, "layers")],
+                      args.smtcal)
     if compiled.returncode != 0:
         fail("smtcal compile: " + compiled.stderr)
     tmp = os.path.join(work, "tmp")
@@ -343,26 +422,85 @@ def trip_paths(binary, work):
     return [trip["path"] for trip in json.loads(result.stdout)["trips"]]
 
 
-def trips_of_cycle(probes, paths):
+def scan_path_points(cell_text, fixture="Board"):
+    """Each scan path's points in the base frame at the fixture's nominal
+    pose (where the runtime drives them), by path name."""
+    cell = tomllib.loads(cell_text)
+    board = next(f for f in cell["fixture"] if f["name"] == fixture)
+    a = math.radians(board.get("angle_deg", 0.0))
+    ox, oy = board["origin_mm"]
+    return {path["name"]: [(ox + math.cos(a) * x - math.sin(a) * y, oy + math.sin(a) * x + math.cos(a) * y)
+                           for x, y in path["points_mm"]] for path in board["scan_path"]}
+
+
+def trips_of_cycle(probes, paths, two_stage, path_points):
     """The trips the runtime latched, by index: its probe moves in order, per
-    path until the first move that did not trip (smtcal_probe_trips.ngc)."""
+    path until the first move that did not trip (smtcal_probe_trips.ngc).
+    With two stages a trip is three probe moves (find the edge, back over
+    it, latch it), the last of them the trip.
+
+    Whether a move tripped: the driver reads motion's flag in the status
+    poll that shows the move's new result, and on a loaded host that poll
+    can come after the next move began and the flag fell back. The runtime
+    leaves a path at its first move that does not trip, so a move followed
+    by another probe move on the same path (the nearest path's points: the
+    markers are far apart) tripped whatever the flag read."""
+    def path_of(probe):
+        return min(path_points, key=lambda name: min(math.dist((probe["x"], probe["y"]), point)
+                                                     for point in path_points[name]))
+
     trips = {}
     at = 0
     index = 0
     for name in dict.fromkeys(paths):  # paths in order
         count = paths.count(name)
         for k in range(count):
-            if at >= len(probes):
+            moves = probes[at:at + (3 if two_stage else 1)]
+            at += len(moves)
+            probed_on = at < len(probes) and path_of(probes[at]) == name
+            if not moves or not (all(probe["tripped"] for probe in moves) or probed_on):
                 break
-            probe = probes[at]
-            at += 1
-            if not probe["tripped"]:
-                break
-            trips[index + k] = probe
+            trips[index + k] = moves[-1]
         index += count
     if at != len(probes):
         fail(f"{len(probes)} probe moves, but the scan paths explain only {at}")
     return trips
+
+
+def scan_overhead(cycle, scan_z):
+    """The scan's overhead in a cycle (s), from the driver's position trace:
+    from its first move (the first status that shows the machine moving
+    after the board was clamped) to the first placement move (the first
+    x-y move after the machine last stood at the scan height: the scan's
+    final rise, then the estimate and the corrections in the interpreter,
+    then the Jump to the first Pick). None without a scan."""
+    trace = cycle.get("trace", [])
+    if len(trace) < 2 or not cycle["probes"]:
+        return None
+    moved = next((s for s in trace[1:] if s[1:] != trace[0][1:]), None)
+    at_scan = [i for i, s in enumerate(trace) if abs(s[3] - scan_z) < 1e-6]
+    if moved is None or not at_scan:
+        return None
+    last = trace[at_scan[-1]]
+    placing = next((s for s in trace[at_scan[-1] + 1:] if s[1:3] != last[1:3]), None)
+    return None if placing is None else placing[0] - moved[0]
+
+
+# The board's corners in its own frame: where the pose's error is measured.
+BOARD_CORNERS = [(0.0, 0.0), (190.0, 0.0), (0.0, 90.0), (190.0, 90.0)]
+
+
+def pose_error(scan, pose):
+    """The largest distance between where the scan's FIX and the true pose put
+    a corner of the board (mm)."""
+    m = scan["fix"]["matrix"]
+    a = math.radians(pose["angle_deg"])
+    worst = 0.0
+    for fx, fy in BOARD_CORNERS:
+        estimated = (m[0][0] * fx + m[0][1] * fy + m[0][3], m[1][0] * fx + m[1][1] * fy + m[1][3])
+        true = (pose["x_mm"] + math.cos(a) * fx - math.sin(a) * fy, pose["y_mm"] + math.sin(a) * fx + math.cos(a) * fy)
+        worst = max(worst, math.dist(estimated, true))
+    return worst
 
 
 def write_trips(path, trips):
@@ -376,6 +514,39 @@ def write_trips(path, trips):
 
 # ------------------------------------------------------------------ the scenario
 
+def cell_copy(work, scenario):
+    """The cell a scenario runs: the example's, or a copy of it (and its
+    tables, named relative to it) with its fixture replaced ("fixture": a
+    file holding a [[fixture]] section), some keys changed ("cell") and some
+    added to its last table ("cell_add")."""
+    if "cell" not in scenario and "fixture" not in scenario and "cell_add" not in scenario:
+        return CELL
+    text = open(CELL).read()
+    if "fixture" in scenario:
+        start, end = text.index("[[fixture]]"), text.index("# --- the feeder banks")
+        section = open(scenario["fixture"]).read()
+        text = text[:start] + section[section.index("\n[[fixture]]") + 1:] + text[end:]
+    for key, value in scenario.get("cell", {}).items():
+        if value is None:  # the key removed
+            text, n = re.subn(rf"(?m)^{key} = .*\n", "", text)
+        else:
+            text, n = re.subn(rf"(?m)^{key} = \S+", f"{key} = {value}", text)
+        if n == 0 and key == "latch_speed_mm_s" and value is not None:  # a fixture key the cell may lack
+            text, n = re.subn(r"(?m)^(scan_speed_mm_s = .*)$", rf"\1\n{key} = {value}", text)
+        if n != 1:
+            fail(f"cannot set {key} in a copy of the cell file")
+    for key, value in scenario.get("cell_add", {}).items():  # keys added to its last table ([linuxcnc])
+        text += f"{key} = {value}\n"
+    cell_dir = os.path.join(work, "cell")
+    os.makedirs(cell_dir)
+    for name in os.listdir(os.path.dirname(CELL)):
+        if name.endswith("-table.csv"):
+            shutil.copy(os.path.join(os.path.dirname(CELL), name), cell_dir)
+    cell = os.path.join(cell_dir, os.path.basename(CELL))
+    open(cell, "w").write(text)
+    return cell
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--smtcal", required=True)
@@ -388,42 +559,65 @@ def main():
         return headless_example(args)
     scenario = SCENARIOS[args.scenario]
     started = time.monotonic()
-
     work = os.path.join(work_root(args.work), args.scenario)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
-    cell = CELL
-    if "cell" in scenario or "cell_add" in scenario:
-        # A copy of the cell (and its tables, named relative to it) with some
-        # keys changed, and some added to its last table ([linuxcnc]).
-        text = open(CELL).read()
-        for key, value in scenario.get("cell", {}).items():
-            text, n = re.subn(rf"(?m)^{key} = \S+", f"{key} = {value}", text)
-            if n != 1:
-                fail(f"cannot set {key} in a copy of the cell file")
-        for key, value in scenario.get("cell_add", {}).items():
-            text += f"{key} = {value}\n"
-        cell_dir = os.path.join(work, "cell")
-        os.makedirs(cell_dir)
-        for name in os.listdir(os.path.dirname(CELL)):
-            if name.endswith("-table.csv"):
-                shutil.copy(os.path.join(os.path.dirname(CELL), name), cell_dir)
-        cell = os.path.join(cell_dir, os.path.basename(CELL))
-        open(cell, "w").write(text)
+    if "variants" not in scenario:
+        run_machine(args, scenario, work)
+        log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
+        return
+    # Several scans of the same boards, one machine run each, side by side.
+    rows = []
+    for variant in scenario["variants"]:
+        variant_work = os.path.join(work, variant["name"])
+        os.makedirs(variant_work)
+        log(f"--- {variant['name']}: {variant['what']}")
+        run = dict(scenario, **variant)
+        measured = run_machine(args, run, variant_work)
+        rows.append((variant, measured))
+    log(f"scan overhead per cycle (first scan move to first placement move) and board pose error (the largest "
+        f"distance of a board corner from where the true pose puts it), {len(scenario['cycles'])} boards each:")
+    log(f"  {'scan':<28} {'overhead s (mean, max)':<24} {'pose error mm (mean, max)':<26} verify's scan s")
+    for variant, measured in rows:
+        overheads = [m["overhead_s"] for m in measured["cycles"] if m["overhead_s"] is not None]
+        errors = [m["pose_error_mm"] for m in measured["cycles"]]
+        log(f"  {variant['name']:<28} {sum(overheads) / len(overheads):6.3f} {max(overheads):6.3f}"
+            f"{'':11} {sum(errors) / len(errors):7.4f} {max(errors):7.4f}{'':11} {measured['verify_scan_s']:.3f}")
+    log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
+
+
+def verify_scan_seconds(args, program, cell):
+    """verify's estimate of the scan's time in the program's cycle."""
+    report = smtcal(["verify", program, "--cell", cell, "--json"], args.smtcal)
+    cycles = json.loads(report.stdout).get("cycles", []) if report.stdout else []
+    return cycles[0]["scan_s"] if cycles and "scan_s" in cycles[0] else float("nan")
+
+
+def run_machine(args, scenario, work):
+    """One run of LinuxCNC on the scenario's boards, checked; what it measured."""
+    cell = cell_copy(work, scenario)
     program_dir = os.path.join(work, "program")
-    compiled = smtcal(["compile", scenario["program"], "--cell", cell, "--target", "linuxcnc", "-o", program_dir]
-                      + (["--dry-run-probe"] if scenario.get("dry_run") else []), args.smtcal)
+    ini = derive_ini(work, program_dir, False)
+    # Compiled against the machine's INI: it and its HAL files are checked
+    # against the cell, and the runtime goes where its SUBROUTINE_PATH says.
+    compiled = smtcal(["compile", scenario["program"], "--cell", cell, "--target", "linuxcnc", "--ini", ini,
+                       "-o", program_dir] + (["--dry-run-probe"] if scenario.get("dry_run") else []), args.smtcal)
     if compiled.returncode != 0:
         fail("smtcal compile: " + compiled.stderr)
+    if scenario.get("dry_run"):
+        # The mistake this scenario makes: the dry-run folder put first on
+        # the machine's path after compiling (compiled against that path,
+        # smtcal would write the runtime into the dry-run folder).
+        ini = derive_ini(work, program_dir, True)
     stem = os.path.splitext(os.path.basename(scenario["program"]))[0]
-    ini = derive_ini(work, program_dir, scenario.get("dry_run", False))
     # Where the robot really puts the sensor around each marker (the cell's tables there, affine).
     model = run([args.checker, "--cell", cell, "--sensor-model"])
     if model.returncode != 0:
         fail("the checker's sensor model: " + model.stderr)
     sensor_models = json.loads(model.stdout)
-    if len(sensor_models) != 2:
-        fail(f"the sensor HAL has two markers; the cell's fixture has {len(sensor_models)} scan paths")
+    if sorted(m["marker"] for m in sensor_models) != [1, 2]:
+        fail(f"the sensor HAL has two markers, one scan path each; the cell's paths scan {sensor_models}")
+    sensor_models.sort(key=lambda m: m["marker"])  # the HAL's units: marker 1's, then marker 2's
     plan = {"program": os.path.join(program_dir, stem + ".ngc"), "cycles": scenario["cycles"],
             "sensor_models": sensor_models, "timeout_s": 120 + 100 * len(scenario["cycles"])}
     if scenario["expect"] == "overhead":
@@ -431,19 +625,8 @@ def main():
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
-    machine_started = time.monotonic()
-    code = start_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
-    machine_s = time.monotonic() - machine_started
-    left = leftover_processes("SMTCAL_SIM_PLAN=" + plan_path)
-    if left:
-        fail("processes of the run outlived it: " + "; ".join(left))
-    if not os.path.exists(run_path):
-        tail = open(os.path.join(work, "linuxcnc.log")).read()[-3000:]
-        if "rtapi" in tail and ("Permission" in tail or "not permitted" in tail):
-            skip("LinuxCNC could not start here:\n" + tail)
-        fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
-    record = json.load(open(run_path))
-    log(f"scenario {args.scenario}: {os.path.basename(scenario['program'])}, {len(record['cycles'])} cycle(s), "
+    record, machine_s = run_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
+    log(f"  {os.path.basename(scenario['program'])}, {len(record['cycles'])} cycle(s), "
         f"LinuxCNC ran {machine_s:.1f} s (ready after {record['times'].get('ready_s', 0):.1f} s), "
         f"run ended: {record['end']}")
     if record["end"].startswith("timeout"):
@@ -451,21 +634,24 @@ def main():
 
     if scenario["expect"] == "dry_run_refused":
         check_dry_run_refused(record)
-        log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
-        return
+        return {"cycles": []}
     if scenario["expect"] == "overhead":
         report_overhead(record, work, scenario["overhead_calls"])
-        log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
-        return
+        return {"cycles": []}
 
     # Per cycle: the latched trips, smtcal fixture's verdict on them.
     paths = trip_paths(args.smtcal, work)
+    cell_text = open(cell).read()
+    two_stage = re.search(r"(?m)^latch_speed_mm_s = ", cell_text) is not None
+    scan_z = float(re.search(r"(?m)^scan_z_mm = (\S+)", cell_text).group(1))
+    path_points = scan_path_points(cell_text)
+    measured = []
     previous = None
     verdicts = []
     check_cycles = []
     latched = []
     for n, cycle in enumerate(record["cycles"]):
-        trips = trips_of_cycle(cycle["probes"], paths)
+        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
         scan_json = os.path.join(work, f"cycle{n + 1}-scan.json")
@@ -480,6 +666,12 @@ def main():
         verdicts.append(verdict)
         if verdict["ok"]:
             previous = scan_json
+        overhead = scan_overhead(cycle, scan_z)
+        if verdict["ok"]:
+            error = pose_error(verdict, cycle["pose"])
+            log(f"  cycle {n + 1}: scan overhead {overhead if overhead is None else round(overhead, 3)} s, "
+                f"board pose error {error:.4f} mm")
+            measured.append({"overhead_s": overhead, "pose_error_mm": error})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
                              "scan": scan_json, "places": [e["position"] + [e["velocity"]] for e in places],
@@ -513,7 +705,7 @@ def main():
     check_record_log(os.path.join(work, RECORD_FILE), latched, verdicts, "monitor" in scenario)
     if "monitor" in scenario:
         check_monitor(args, scenario, cell, os.path.join(work, RECORD_FILE))
-    log(f"scenario {args.scenario}: passed in {time.monotonic() - started:.1f} s")
+    return {"cycles": measured, "verify_scan_s": verify_scan_seconds(args, scenario["program"], cell)}
 
 
 # ------------------------------------------------------------------ the cycle record

@@ -10,6 +10,7 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -50,13 +51,18 @@ struct Imported {
 
 // Runs the import the way `smtcal import` does, on a list given as text.
 Imported Import(const std::string& list, ImportOptions options = {}, const fs::path& feeders = kData / "feeders.toml",
-                cad::ReadOptions read = {}, const std::string& list_name = "list.csv") {
+                cad::ReadOptions read = {}, const std::string& list_name = "list.csv",
+                const fs::path& cell_file = kData / "cell.toml") {
   SourceManager sources;
   Diagnostics diags(sources);
   Imported out;
-  Result<std::optional<cell::Cell>> cell = cell::LoadCell((kData / "cell.toml").string(), sources, diags);
+  Result<std::optional<cell::Cell>> cell = cell::LoadCell(cell_file.string(), sources, diags);
   EXPECT_TRUE(cell.ok() && cell.value()) << diags.RenderText();
   if (!cell.ok() || !cell.value()) return out;
+  // The fixture's pocket, as `smtcal import` takes it from the cell.
+  if (const auto& pocket = cell.value()->fixtures.front().pocket_mm; pocket && !options.pocket) {
+    options.pocket = std::array<double, 4>{(*pocket)[0].lo, (*pocket)[1].lo, (*pocket)[0].hi, (*pocket)[1].hi};
+  }
   cad::FeedersFile file;
   if (!feeders.empty()) {
     Result<std::optional<cad::FeedersFile>> loaded = cad::LoadFeeders(feeders.string(), sources, diags);
@@ -260,6 +266,96 @@ TEST(CadImport, KicadListsPlaceEveryPadWhereKicadPutIt) {
   }
 }
 
+// KiCad's StickHub demo board (both sides populated), exported by KiCad 6
+// with its drill/place file origin on the lower left corner of the board's
+// outline (import-data/generate_kicad_demo_lists.py), against where KiCad
+// has every footprint (import-data/stickhub-truth.csv). Imported without
+// --origin onto a fixture with a pocket, the top and the bottom land in the
+// same pocket: the board's outline fills the pocket's corner either side
+// up, and every part is where it is on the board lying there (the bottom
+// turned over about the board's own y edge).
+TEST(CadImport, BothSidesOfAKicadBoardUseTheSamePocket) {
+  const fs::path kicad = fs::path(SMTCAL_SOURCE_DIR) / "tests" / "golden" / "import-kicad";
+  std::istringstream in(test::ReadFileText(kData / "stickhub-truth.csv"));
+  std::string line;
+  std::getline(in, line);  // "# outline,W,H"
+  ASSERT_EQ(line.rfind("# outline,", 0), 0u) << line;
+  const double width = std::stod(line.substr(10)), height = std::stod(line.substr(line.rfind(',') + 1));
+  std::getline(in, line);  // header
+  struct Footprint {
+    std::string side;
+    double x, y;
+  };
+  std::map<std::string, Footprint> truth;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::istringstream fields(line);
+    for (std::string item; std::getline(fields, item, ',');) f.push_back(item);
+    ASSERT_EQ(f.size(), 4u) << line;
+    truth[f[0]] = {f[1], std::stod(f[2]), std::stod(f[3])};
+  }
+  const double pocket_x = 100, pocket_y = 20;  // pocket-cell.toml's pocket, lower left corner
+  for (const std::string side : {"top", "bottom"}) {
+    SCOPED_TRACE(side);
+    ImportOptions options;
+    options.side = side == "top" ? cad::Side::kTop : cad::Side::kBottom;
+    options.origin_given = false;
+    options.board = std::array<double, 4>{0, 0, width, height};
+    options.skip_unmapped = true;
+    const std::string file = "stickhub_" + side + ".pos";
+    Imported r = Import(test::ReadFileText(kicad / file), options, kData / "stickhub-feeders.toml", {}, file,
+                        kData / "pocket-cell.toml");
+    ASSERT_TRUE(r.program) << r.diagnostics;
+    EXPECT_EQ(std::count(r.kinds.begin(), r.kinds.end(), DiagKind::ImportOutlineFromParts), 0) << r.diagnostics;
+    std::array<double, 4> origin{};
+    std::map<std::string, std::array<double, 4>> placed;
+    for (const ir::StmtPtr& stmt : r.program->items) {
+      if (const auto* local = std::get_if<ir::LocalDecl>(&stmt->node)) origin = local->origin.values;
+      if (const auto* point = std::get_if<ir::PointDecl>(&stmt->node); point != nullptr && point->frame == "Pcb") {
+        placed[point->name] = point->coords.values;
+      }
+    }
+    ASSERT_EQ(origin[3], 0.0);
+    // The outline as placed: the top view's corners, turned over for the bottom.
+    const double sign = side == "top" ? 1 : -1;
+    const double corner_x = origin[0] + std::min(0.0, sign * width), corner_y = origin[1];
+    EXPECT_NEAR(corner_x, pocket_x, 1e-9);
+    EXPECT_NEAR(corner_y, pocket_y, 1e-9);
+    std::size_t checked = 0;
+    for (const auto& [ref, at] : placed) {
+      ASSERT_TRUE(truth.count(ref)) << ref;
+      const Footprint& fp = truth[ref];
+      EXPECT_EQ(fp.side, side) << ref;
+      // Where the part is on the board lying in the pocket.
+      const double want_x = pocket_x + (side == "top" ? fp.x : width - fp.x), want_y = pocket_y + fp.y;
+      EXPECT_NEAR(origin[0] + at[0], want_x, 1e-4) << ref;
+      EXPECT_NEAR(origin[1] + at[1], want_y, 1e-4) << ref;
+      ++checked;
+    }
+    EXPECT_EQ(checked, side == "top" ? 35u : 50u);  // every part of the side (stickhub_*.err: 35 and 50 placed)
+  }
+}
+
+// A part outside the outline --board gives is an error at its row; without
+// --board the parts' bounding box stands for the board, with a warning.
+TEST(CadImport, PartsOffTheBoardAndTheOutlineFromTheParts) {
+  const fs::path kicad = fs::path(SMTCAL_SOURCE_DIR) / "tests" / "golden" / "import-kicad";
+  ImportOptions options;
+  options.side = cad::Side::kBottom;
+  options.origin_given = false;
+  options.skip_unmapped = true;
+  options.board = std::array<double, 4>{0, 0, 16.6, 20};  // the board is 40.1 mm high
+  Imported off = Import(test::ReadFileText(kicad / "stickhub_bottom.pos"), options, kData / "stickhub-feeders.toml", {},
+                        "stickhub_bottom.pos", kData / "pocket-cell.toml");
+  EXPECT_FALSE(off.program);
+  EXPECT_GT(std::count(off.kinds.begin(), off.kinds.end(), DiagKind::ImportPartOffBoard), 5) << off.diagnostics;
+  options.board.reset();
+  Imported box = Import(test::ReadFileText(kicad / "stickhub_bottom.pos"), options, kData / "stickhub-feeders.toml", {},
+                        "stickhub_bottom.pos", kData / "pocket-cell.toml");
+  ASSERT_TRUE(box.program) << box.diagnostics;
+  EXPECT_EQ(std::count(box.kinds.begin(), box.kinds.end(), DiagKind::ImportOutlineFromParts), 1) << box.diagnostics;
+}
+
 TEST(CadImport, FeederMatching) {
   SourceManager sources;
   Diagnostics diags(sources);
@@ -350,7 +446,8 @@ TEST(CadImport, NamesAreValidAndNeverKeywords) {
   }
 }
 
-// Every row of a random list ends as a placement or a diagnostic at its line.
+// Every row of a random list ends as a placement, a skipped row the summary
+// names (its group warned once), or an error at its line.
 TEST(CadImportProperty, EveryRowIsPlacedOrReported) {
   const std::vector<std::string> packages = {"C_0603_1608Metric", "R_0603_1608Metric", "SOIC-8", "L_1210",
                                              "Fiducial_1mm"};
@@ -378,15 +475,28 @@ TEST(CadImportProperty, EveryRowIsPlacedOrReported) {
     Imported r = Import(list, options, kData / "feeders.toml");
     std::size_t skipped = 0;
     for (std::size_t n : r.summary.skipped) skipped += n;
-    std::size_t reported = 0;
+    // Skipped rows give one warning per group (reason and rule), at its
+    // first row, and the summary's groups name every skipped row once; a
+    // bad number is an error of its own row.
+    std::size_t skip_warnings = 0, bad_numbers = 0;
     for (DiagKind kind : r.kinds) {
-      if (kind == DiagKind::CadBadNumber || kind == DiagKind::ImportSkippedSide || kind == DiagKind::ImportSkippedDnp ||
+      if (kind == DiagKind::ImportSkippedSide || kind == DiagKind::ImportSkippedDnp ||
           kind == DiagKind::ImportExcluded || kind == DiagKind::ImportSkippedUnmapped) {
-        ++reported;
+        ++skip_warnings;
       }
+      bad_numbers += kind == DiagKind::CadBadNumber;
+    }
+    std::size_t named = 0;
+    std::set<std::string> names;
+    for (const SkipGroup& group : r.summary.skip_groups) {
+      named += group.names.size();
+      names.insert(group.names.begin(), group.names.end());
     }
     EXPECT_EQ(r.summary.rows_read, static_cast<std::size_t>(rows));
-    EXPECT_EQ(reported, skipped + r.summary.rows_with_errors) << r.diagnostics;
+    EXPECT_EQ(skip_warnings, r.summary.skip_groups.size()) << r.diagnostics;
+    EXPECT_EQ(named, skipped) << r.diagnostics;
+    EXPECT_EQ(names.size(), skipped) << "a row named twice\n" << r.diagnostics;
+    EXPECT_EQ(bad_numbers, r.summary.rows_with_errors) << r.diagnostics;
     if (r.program) {
       EXPECT_EQ(r.summary.parts_placed + skipped + r.summary.rows_with_errors, static_cast<std::size_t>(rows));
       EXPECT_EQ(static_cast<std::size_t>(std::count(r.text.begin(), r.text.end(), '\n')) > 0, true);

@@ -318,10 +318,14 @@ TEST(LinuxCncEmit, DryRunProbeFileRunsTheWholeExampleInRs274) {
 TEST(LinuxCncEmit, ShippedExampleConfigurationFindsTheSubroutines) {
   ASSERT_TRUE(test::HaveRs274()) << "rs274 is not installed: install linuxcnc-uspace (tools/install-deps.sh)";
   fs::path dir = Scratch("config");
-  for (const char* name : {"paper-cell.ini", "paper-cell.hal", "paper-cell.tbl"}) {
+  for (const char* name : {"paper-cell.ini", "paper-cell.hal", "paper-cell.tbl", "paper-cell.var"}) {
     fs::copy_file(kSource / "examples" / "linuxcnc" / name, dir / name);
   }
-  test::SmtcalRun compiled = CompileToDir(kExample, kCell, dir / "layers");
+  // As examples/linuxcnc/README.md compiles it: against the machine's INI,
+  // the runtime into the folder its SUBROUTINE_PATH names first.
+  test::SmtcalRun compiled = test::RunSmtcal(fmt::format("compile {} --cell {} --target linuxcnc --ini {} -o {}",
+                                                         Quote(kExample), Quote(kCell), Quote(dir / "paper-cell.ini"),
+                                                         Quote(dir / "layers")));
   ASSERT_EQ(compiled.exit_code, 0) << compiled.err;
   // HOME=.: rs274 maps $HOME/.tool.mmap; parallel runs must not share it.
   std::string command = fmt::format("cd {} && HOME=. rs274 -i paper-cell.ini -g layers/layers.ngc </dev/null >out 2>err",

@@ -468,6 +468,29 @@ TEST(DiffSvg, LabelsStayInsideTheFrameAndApart) {
   }
 }
 
+// Moves of 10 µm among targets 1 mm apart: the arrows are enlarged so the
+// longest stays within 0.6 of that spacing (and 0.12 of the panel), not
+// the panel's span alone (which would draw them 20 mm long).
+TEST(DiffSvg, ArrowsStayWithinTheTargetsSpacing) {
+  std::string points, moved, uses;
+  for (int k = 0; k < 8; ++k) {
+    points += fmt::format("Point P{} = XY({}.0, 10.0, -3.0, 0.0)\n", k, 100 + k);
+    moved += fmt::format("Point P{} = XY({}, 10.0, -3.0, 0.0)\n", k, 100 + k + 0.01);
+    uses += fmt::format("  Jump P{}\n", k);
+  }
+  const std::string head = "Program L\nUnits mm\nPoint Far = XY(300.0, 200.0, -3.0, 0.0)\n";
+  const std::string tail = "\nFunction Main\n" + uses + "  Jump Far\nFend\n";
+  auto run = RunDiff(head + points + tail, head + moved + tail);
+  const std::string svg = PlotDiffSvg(run->diff);
+  const std::regex stated(R"(the longest, 10\.0 µm, is drawn ([\d.]+) mm long, within 0\.6 of the targets' median spacing \(([\d.]+) mm\))");
+  std::smatch match;
+  ASSERT_TRUE(std::regex_search(svg, match, stated)) << svg;
+  const double drawn_mm = std::stod(match[1]), spacing_mm = std::stod(match[2]);
+  EXPECT_DOUBLE_EQ(spacing_mm, 1.0);
+  EXPECT_LE(drawn_mm, 0.6 * spacing_mm);
+  EXPECT_GE(drawn_mm, 0.6 * spacing_mm / 2.5);  // the round factor is at most 2.5 below the limit
+}
+
 // ------------------------------------------------------------------ the command
 
 namespace fs = std::filesystem;

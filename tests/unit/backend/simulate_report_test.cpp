@@ -2,7 +2,7 @@
 // as a reader sees it: scatter panels with both axes ticked and labelled in
 // µm, a histogram with a labelled share scale, and a mode that placed nothing
 // drawn as a note naming the checks that stopped it, with no empty axes and
-// no flat curve. Built from a hand-made SimResult, so every number is known.
+// no flat curve; the paper's modes say they run without scan checks. Built from a hand-made SimResult, so every number is known.
 #include <string>
 #include <vector>
 
@@ -115,6 +115,28 @@ TEST(SimulateSvg, PartlyStoppedModeWithNothingPlacedSaysHowMany) {
   run.result.modes[1].fault_checks = {{"length_l1", 3}};
   const std::string svg = run.Svg();
   EXPECT_NE(PanelOf(svg, "periphery").find(">no placements: 3 of 4 cycles stopped by</text>"), std::string::npos);
+}
+
+TEST(SimulateSvg, ThePapersModesSayTheyRunWithoutChecksAndWhatTheChecksWouldStop) {
+  SimRun run = TwoModes();
+  ModeResult& periphery = run.result.modes[1];
+  periphery.faults = 0;
+  periphery.fault_checks.clear();
+  periphery.would_stop = 4;
+  periphery.would_stop_checks = {{"length_l1", 4}};
+  periphery.placements = 4;
+  periphery.errors_um = {5000, 3000, 9000, 80};  // Eq. 4 on short edges: millimetres off
+  periphery.scatter_um = {{5000, 0}, {0, 3000}, {9000, 0}, {80, 0}};
+  const std::string svg = run.Svg();
+  EXPECT_NE(PanelOf(svg, "periphery").find("no scan checks (the cell's would stop 4)"), std::string::npos) << svg;
+  EXPECT_EQ(PanelOf(svg, "none").find("no scan checks"), std::string::npos) << "only the paper's modes";
+  // Three of its four parts in the last bin: the scale stays the others'
+  // (one part in three: 40 %), the last bin is clipped and written out.
+  const std::string histogram = svg.substr(svg.find("Error length histogram"));
+  EXPECT_NE(histogram.find(">40%</text>"), std::string::npos);
+  EXPECT_EQ(histogram.find(">80%</text>"), std::string::npos);
+  EXPECT_NE(histogram.find(">periphery: 75.0% at 295 µm or more (last bin, clipped)</text>"), std::string::npos)
+      << histogram;
 }
 
 TEST(SimulateSvg, HistogramOfNoPlacementSaysSo) {

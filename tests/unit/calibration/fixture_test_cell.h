@@ -64,6 +64,26 @@ inline cell::Fixture PaperFixture(cell::Estimator estimator = cell::Estimator::k
   return f;
 }
 
+// The same board with the example's hairpin paths (examples/paper-cell/
+// paper.cell.toml): marker 2's path first, every leg across its edge at a
+// right angle through the edge's middle; two-stage probing at 40 and 8 mm/s.
+inline cell::Fixture HairpinFixture(cell::Estimator estimator = cell::Estimator::kRigid) {
+  cell::Fixture f = PaperFixture(estimator);
+  cell::ScanPath m2, m1;
+  m2.name = "M2";
+  m2.points = {cell::Point2(194.1, 85.9), cell::Point2(185.9, 85.9), cell::Point2(185.9, 94.1),
+               cell::Point2(186.1, 94.1), cell::Point2(186.1, 86.1), cell::Point2(194.1, 86.1)};
+  m1.name = "M1";
+  m1.points = {cell::Point2(-2.6, 3.9), cell::Point2(3.9, 3.9), cell::Point2(3.9, -2.6),
+               cell::Point2(4.1, -2.6), cell::Point2(4.1, 4.1), cell::Point2(-2.6, 4.1)};
+  f.scan_paths = {m2, m1};
+  f.scan_speed_mm_s = 40;
+  f.latch_speed_mm_s = 8;
+  f.trip_window_mm = 4.5;
+  f.max_line_residual_mm = 0.07;
+  return f;
+}
+
 // Where a straight move from `from` to `to` (base frame) crosses the line
 // n . x = d (base frame), as a parameter along the move; nullopt when
 // parallel.

@@ -1,6 +1,8 @@
 // The driver's contract: exit codes, --help on every subcommand, --version,
 // and atomic outputs. Runs the real smtcal executable.
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -90,3 +92,21 @@ TEST(Cli, OutputThatWouldOverwriteAnInputIsRefused) {
 }
 
 }  // namespace
+
+// The README shows docs/images/paper-cell.svg as what `smtcal cell plot`
+// draws for the example; it must stay exactly that picture.
+// SMTCAL_UPDATE_GOLDEN=1 rewrites it (review it as a PNG before committing).
+TEST(Cli, ReadmePictureOfTheExampleCellIsWhatCellPlotDraws) {
+  const std::filesystem::path root(SMTCAL_SOURCE_DIR);
+  smtcal::test::SmtcalRun run = smtcal::test::RunSmtcal(
+      "cell plot examples/paper-cell/paper.cell.toml --program examples/paper-cell/layers.place -o -", root);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::filesystem::path picture = root / "docs" / "images" / "paper-cell.svg";
+  const char* update = std::getenv("SMTCAL_UPDATE_GOLDEN");
+  if (update != nullptr && std::string(update) == "1") {
+    std::ofstream(picture, std::ios::binary) << run.out;
+    return;
+  }
+  EXPECT_EQ(run.out, smtcal::test::ReadFileText(picture))
+      << "docs/images/paper-cell.svg is not what `smtcal cell plot` draws; rewrite it with SMTCAL_UPDATE_GOLDEN=1";
+}

@@ -1,7 +1,9 @@
 // Golden-file tests: each case is an input beside its expected output.
 //
 // A suite is a folder tests/golden/<suite>/ with an ARGS file holding the
-// smtcal arguments ({input} stands for the case's file name). Every other
+// smtcal arguments ({input} stands for the case's file name; {scratch} for a
+// fresh folder outside the tree, for outputs the case does not compare, so
+// that the one it compares can go to standard output). Every other
 // file that is not *.out, *.err, *.args or ARGS is a case. The harness runs
 // smtcal in the suite folder and compares stdout with <case>.out and stderr
 // with <case>.err (a missing file means "expected empty"). A case named
@@ -20,6 +22,8 @@
 #include <tuple>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
@@ -109,8 +113,27 @@ TEST_P(GoldenFiles, MatchesExpectedOutput) {
   for (std::size_t at; (at = args.find("{input}")) != std::string::npos;) {
     args.replace(at, 7, ShellQuote(c.input));
   }
+  std::string scratch;
+  if (args.find("{scratch}") != std::string::npos) {
+    static int scratch_count = 0;
+    scratch = (fs::temp_directory_path() / ("smtcal_golden_scratch_" + std::to_string(::getpid()) + "_" +
+                                            std::to_string(++scratch_count)))
+                  .string();
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    for (std::size_t at; (at = args.find("{scratch}")) != std::string::npos;) {
+      args.replace(at, 9, ShellQuote(scratch));
+    }
+  }
   smtcal::test::SmtcalRun run = smtcal::test::RunSmtcal(args, c.suite);
   ASSERT_NE(run.exit_code, -1) << run.command;
+  if (!scratch.empty()) {
+    // The folder's name changes from run to run; the expectations say {scratch}.
+    for (std::string* text : {&run.out, &run.err}) {
+      for (std::size_t at; (at = text->find(scratch)) != std::string::npos;) text->replace(at, scratch.size(), "{scratch}");
+    }
+    fs::remove_all(scratch);
+  }
 
   bool must_fail = c.input.rfind("fail_", 0) == 0;
   int expected_exit = must_fail ? 1 : 0;

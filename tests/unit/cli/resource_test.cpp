@@ -71,16 +71,19 @@ TEST(Resources, SimulateRefusesARunThatCannotFitInMemory) {
   if (kSanitized) GTEST_SKIP() << "ulimit -v and the sanitizers' shadow memory do not mix";
   fs::path dir = Scratch("simulate");
   std::ofstream(dir / "board.place") << bench::GeneratePlacements(2000);
-  // 2000 placements x 100 000 cycles x 56 bytes = 11.2 GB of kept errors.
-  LimitedRun refused = RunWithMemoryLimit(dir, 3000000, fmt::format("simulate board.place --cell '{}' --cycles 100000", kCell));
+  // 2000 placements x 5000 cycles x 56 bytes = 0.56 GB of kept errors, more
+  // than a 400 MB address space; 1e7 placements are within the run's own
+  // bound (limits::kMaxSimulatedPlacements, Hostile tests), so this is the
+  // memory check speaking.
+  LimitedRun refused = RunWithMemoryLimit(dir, 400000, fmt::format("simulate board.place --cell '{}' --cycles 5000", kCell));
   EXPECT_EQ(refused.exit_code, 3) << refused.err;
-  EXPECT_NE(refused.err.find("simulating 100000 cycles of 2000 placements keeps 11.2 GB of placement errors (56 "
+  EXPECT_NE(refused.err.find("simulating 5000 cycles of 2000 placements keeps 0.6 GB of placement errors (56 "
                              "bytes a placement)"),
             std::string::npos)
       << refused.err;
   EXPECT_NE(refused.err.find("; simulate at most"), std::string::npos) << refused.err;
   // What fits runs.
-  LimitedRun fits = RunWithMemoryLimit(dir, 3000000, fmt::format("simulate board.place --cell '{}' --cycles 20", kCell));
+  LimitedRun fits = RunWithMemoryLimit(dir, 400000, fmt::format("simulate board.place --cell '{}' --cycles 20", kCell));
   EXPECT_EQ(fits.exit_code, 0) << fits.err;
   fs::remove_all(dir);
 }

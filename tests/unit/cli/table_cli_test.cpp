@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -39,13 +40,13 @@ class TableCli : public testing::Test {
 };
 
 TEST_F(TableCli, EverySubcommandHasHelp) {
-  for (const char* sub : {"build", "check", "stats", "forward", "inverse", "plot"}) {
+  for (const char* sub : {"build", "check", "stats", "forward", "inverse", "plot", "diff"}) {
     CliRun help = Smtcal(fmt::format("table {} --help", sub));
     EXPECT_EQ(help.exit_code, 0) << sub;
     EXPECT_NE(help.out.find("Usage"), std::string::npos) << sub;
   }
   CliRun table = Smtcal("table --help");
-  for (const char* sub : {"build", "check", "stats", "forward", "inverse", "plot"}) {
+  for (const char* sub : {"build", "check", "stats", "forward", "inverse", "plot", "diff"}) {
     EXPECT_NE(table.out.find(sub), std::string::npos) << sub;
   }
 }
@@ -108,6 +109,35 @@ TEST_F(TableCli, BuildAndPlotWriteTheirFiles) {
   for (const auto& entry : fs::directory_iterator(dir)) {
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << "leftover " << entry.path();
   }
+}
+
+TEST_F(TableCli, DiffDrawsTheChangeAndGatesOnTheThreshold) {
+  fs::path dir = TempDir();
+  fs::path shifted = dir / "shifted.csv", picture = dir / "change.svg";
+  // Every y error 20 µm larger.
+  std::istringstream in(ReadFileText(kTable));
+  std::ofstream out(shifted);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("y,", 0) == 0) {
+      std::size_t c3 = line.find(',', line.find(',', 2) + 1), c4 = line.find(',', c3 + 1);
+      line = line.substr(0, c3 + 1) + fmt::format("{:.6f}", std::stod(line.substr(c3 + 1, c4 - c3 - 1)) + 0.020) +
+             line.substr(c4);
+    }
+    out << line << "\n";
+  }
+  out.close();
+  CliRun gate = Smtcal(fmt::format("table diff {} {} --svg {}", kTable, shifted.string(), picture.string()));
+  EXPECT_EQ(gate.exit_code, 1) << gate.err;
+  EXPECT_NE(gate.out.find("Δy: 121 nodes of the same grid"), std::string::npos) << gate.out;
+  EXPECT_NE(gate.out.find("max |change| 20.0 µm, mean +20.0 µm"), std::string::npos) << gate.out;
+  const std::string svg = ReadFileText(picture);
+  EXPECT_EQ(svg.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0), 0u);
+  EXPECT_NE(svg.find("change of Δy, 11 x 11 nodes"), std::string::npos);
+  EXPECT_NE(svg.find("µm"), std::string::npos);
+  EXPECT_EQ(Smtcal(fmt::format("table diff {} {} --threshold 20.5", kTable, shifted.string())).exit_code, 0);
+  EXPECT_EQ(Smtcal(fmt::format("table diff {} {} --exit-zero", kTable, shifted.string())).exit_code, 0);
+  EXPECT_EQ(Smtcal(fmt::format("table diff {} {}", kTable, kTable)).exit_code, 0);
+  EXPECT_EQ(Smtcal(fmt::format("table diff - - ")).exit_code, 2);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 
 #include "calibration/fixture_geometry.h"
 #include "calibration/placement_budget.h"
+#include "calibration/scan_plan.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
 #include "ir/ir.h"
@@ -160,8 +161,12 @@ max_line_residual_mm = 0.05
 }
 
 // The paper board's trip points in fixture coordinates, T1..T8.
+// The V paths' trips (the cells written by these tests), and the example
+// file's hairpins'.
 const std::vector<Point2> kPaperTrips = {{0, 3},   {3, 0},   {4.2, 0},    {0, 7},
                                          {190, 87}, {187, 90}, {185.8, 90}, {190, 83}};
+const std::vector<Point2> kExampleTrips = {{190, 85.9}, {185.9, 90}, {186.1, 90}, {190, 86.1},
+                                           {0, 3.9},    {3.9, 0},    {4.1, 0},    {0, 4.1}};
 
 std::string TeachTrips(const std::vector<Point2>& trips) {
   std::string text = "teach_trips_mm = [";
@@ -237,25 +242,24 @@ TEST(PaperCellFile, TripsAndTeachScanAreTheStatedGeometry) {
   ASSERT_TRUE(loaded.cell.has_value()) << loaded.diagnostics;
   const Fixture& board = loaded.cell->fixtures[0];
   std::vector<ExpectedTrip> trips = ExpectedTrips(board);
-  ASSERT_EQ(trips.size(), kPaperTrips.size());
-  const int edges[] = {1, 0, 0, 1, 2, 3, 3, 2};  // p2 p1 p1 p2 p3 p4 p4 p3
+  ASSERT_EQ(trips.size(), kExampleTrips.size());
+  const int edges[] = {2, 3, 3, 2, 1, 0, 0, 1};  // p3 p4 p4 p3 p2 p1 p1 p2
   for (std::size_t k = 0; k < trips.size(); ++k) {
-    EXPECT_LT((trips[k].in_fixture - kPaperTrips[k]).norm(), 1e-12) << "T" << k + 1;
+    EXPECT_LT((trips[k].in_fixture - kExampleTrips[k]).norm(), 1e-12) << "T" << k + 1;
     EXPECT_EQ(trips[k].edge, edges[k]) << "T" << k + 1;
   }
   // The teach scan: a board at (138.120, 39.950) turned by +0.050 deg,
   // written with 4 decimals (so within half a unit of the 4th decimal).
   const Eigen::Affine3d taught = PlanarFix(Point2(138.120, 39.950), 0.050 * kRadPerDeg);
   for (std::size_t k = 0; k < trips.size(); ++k) {
-    Point2 exact = ToBase(taught, kPaperTrips[k]);
+    Point2 exact = ToBase(taught, kExampleTrips[k]);
     EXPECT_LE((board.teach_trips_mm[k] - exact).cwiseAbs().maxCoeff(), 0.00005 + 1e-12) << "T" << k + 1;
   }
-  // The two V paths at the scan speed take about the paper's 5 s.
-  double length = 0;
-  for (const ScanPath& path : board.scan_paths) {
-    for (std::size_t i = 0; i + 1 < path.points.size(); ++i) length += (path.points[i + 1] - path.points[i]).norm();
-  }
-  EXPECT_NEAR(length / board.scan_speed_mm_s, 5.0, 0.25);
+  // Two stages, and paths that take every board the limits accept.
+  EXPECT_EQ(board.scan_speed_mm_s, 40);
+  EXPECT_EQ(board.latch_speed_mm_s, 8);
+  EXPECT_EQ(board.TripLatchSpeedMmS(), 8);
+  EXPECT_GE(ScanCaptureRange(board).factor, 1.0) << ScanCaptureRange(board).limited_by;
 }
 
 // Every point of layers.place lies in the region it belongs to for every
@@ -415,6 +419,34 @@ TEST_F(CellText, MarkerGeometryToleranceIsAMicrometreFraction) {
   EXPECT_EQ(off.count(DiagKind::CellMarkerGeometry), 1u) << off.diagnostics;
   EXPECT_GT(kMarkerGeometryTolMm, 5e-7);
   EXPECT_LT(kMarkerGeometryTolMm, 2e-6);
+}
+
+// Two-stage probing: the latch feed is optional, above 0, and never above
+// the search's; the latency then follows it.
+TEST_F(CellText, LatchSpeedIsTheSlowStage) {
+  Loaded one = Load(kRobot + FixtureText(138, 40, 0, ""));
+  ASSERT_TRUE(one.cell.has_value()) << one.diagnostics;
+  EXPECT_EQ(one.cell->fixtures[0].latch_speed_mm_s, 0);
+  EXPECT_EQ(one.cell->fixtures[0].TripLatchSpeedMmS(), 12);
+  Loaded two = Load(kRobot + FixtureText(138, 40, 0, "latch_speed_mm_s = 4"));
+  ASSERT_TRUE(two.cell.has_value()) << two.diagnostics;
+  EXPECT_EQ(two.cell->fixtures[0].latch_speed_mm_s, 4);
+  EXPECT_EQ(two.cell->fixtures[0].TripLatchSpeedMmS(), 4);
+  for (const char* bad : {"latch_speed_mm_s = 0", "latch_speed_mm_s = -1", "latch_speed_mm_s = 13"}) {
+    Loaded refused = Load(kRobot + FixtureText(138, 40, 0, bad));
+    EXPECT_FALSE(refused.cell.has_value()) << bad;
+    EXPECT_EQ(refused.count(DiagKind::CellValueOutOfRange), 1u) << bad << ": " << refused.diagnostics;
+  }
+  // The controller's turnaround per probe move: 0.025 s unless stated, 0 to 1 s.
+  EXPECT_EQ(one.cell->robot.probe_turnaround_s, 0.025);
+  Loaded turnaround = Load(kRobot + "probe_turnaround_s = 0.004\n" + FixtureText(138, 40, 0, ""));
+  ASSERT_TRUE(turnaround.cell.has_value()) << turnaround.diagnostics;
+  EXPECT_EQ(turnaround.cell->robot.probe_turnaround_s, 0.004);
+  for (const char* bad : {"probe_turnaround_s = -0.01\n", "probe_turnaround_s = 2\n"}) {
+    Loaded refused = Load(kRobot + bad + FixtureText(138, 40, 0, ""));
+    EXPECT_FALSE(refused.cell.has_value()) << bad;
+    EXPECT_EQ(refused.count(DiagKind::CellValueOutOfRange), 1u) << bad << ": " << refused.diagnostics;
+  }
 }
 
 // Random nominal poses and teach-time boards near them: a teach scan is

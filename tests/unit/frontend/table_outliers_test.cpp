@@ -1,6 +1,7 @@
 // Outlier nodes of error tables (calibration/table_outliers.h): none in smooth
 // tables, random or the example's; a slipped digit, a lost sign or a bad
-// measurement in any node is found, with the slip named. Seed:
+// measurement in any node is found, with the slip named; two adjacent slips
+// are both named and no neighbour is blamed. Seed:
 // SMTCAL_TEST_SEED.
 #include <cmath>
 #include <numbers>
@@ -109,6 +110,56 @@ TEST(TableOutliers, ABadMeasurementIsFoundWithoutASlipToName) {
   const std::vector<TableOutlier> outliers = FindTableOutliers(table);
   ASSERT_EQ(outliers.size(), 1u);
   EXPECT_EQ(outliers[0].i, 5u);
+}
+
+// Two adjacent nodes slipped: both are named, once each, with predictions
+// from their good neighbours; no neighbour is blamed.
+TEST(TableOutliers, TwoAdjacentSlippedNodesAreBothNamedAndNothingElse) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  std::mt19937_64 rng(seed);
+  for (int trial = 0; trial < 100; ++trial) {
+    ErrorTable table = MeasuredLikeTable(rng);
+    const TableAxis axis = trial % 2 == 0 ? TableAxis::X : TableAxis::Y;
+    AxisTable& t = table.axes[static_cast<int>(axis)];
+    const std::size_t i = static_cast<std::size_t>(trial % 10), j = static_cast<std::size_t>((trial * 7) % 11);
+    const double a = t.error_mm[t.Index(i, j)], b = t.error_mm[t.Index(i + 1, j)];
+    const double fa = trial % 3 == 0 ? -1 : 10, fb = trial % 3 == 1 ? -1 : 10;
+    // Two small slips side by side can hide each other: 30 µm each is plain.
+    if (std::abs(a * (fa - 1)) < 0.03 || std::abs(b * (fb - 1)) < 0.03) continue;
+    t.error_mm[t.Index(i, j)] = a * fa;
+    t.error_mm[t.Index(i + 1, j)] = b * fb;
+    const std::vector<TableOutlier> outliers = FindTableOutliers(table);
+    std::string found;
+    for (const TableOutlier& o : outliers) {
+      found += fmt::format(" ({}, {}) {:.6f} predicted {:.6f} [{}];", o.i, o.j, o.value_mm, o.predicted_mm, o.likely_slip);
+    }
+    ASSERT_EQ(outliers.size(), 2u) << "trial " << trial << " at " << i << ", " << j << ":" << found;
+    EXPECT_EQ(outliers[0].i, i);
+    EXPECT_EQ(outliers[1].i, i + 1);
+    EXPECT_EQ(outliers[0].j, j);
+    EXPECT_EQ(outliers[1].j, j);
+    EXPECT_NEAR(outliers[0].predicted_mm, a, 0.005);
+    EXPECT_NEAR(outliers[1].predicted_mm, b, 0.005);
+  }
+}
+
+// A node whose own measurements scatter far beyond its axis's (one bad
+// reading among them) is the one blamed, not the neighbours its mean spoils.
+TEST(TableOutliers, ANodeWithABadReadingIsBlamedNotItsNeighbours) {
+  std::mt19937_64 rng(test::FixtureSeed());
+  ErrorTable table = MeasuredLikeTable(rng);
+  AxisTable& t = table.axes[0];
+  const std::size_t node = t.Index(5, 5);
+  // The case: one reading of -77.0 among twenty of -0.077.
+  t.error_mm[node] = (19 * -0.077 - 77.0) / 20;
+  t.stddev_mm[node] = 17.2;
+  const std::vector<TableOutlier> outliers = FindTableOutliers(table);
+  ASSERT_EQ(outliers.size(), 1u);
+  EXPECT_EQ(outliers[0].i, 5u);
+  EXPECT_EQ(outliers[0].j, 5u);
+  EXPECT_NE(outliers[0].likely_slip.find("a bad measurement among its 20"), std::string::npos)
+      << outliers[0].likely_slip;
 }
 
 }  // namespace

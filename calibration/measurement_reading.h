@@ -1,0 +1,70 @@
+// From the measuring program's readings to the robot's error at the nodes
+// (`smtcal measure read`, docs/measure.md, "What a reading means"):
+//
+//   transducer  e = ((measuring - reference) - zero_mm) / slope along the
+//               visit's axis: the flank turns the error into a height, the
+//               reference takes out the robot's z error (paper, Fig. 4);
+//   external    e = measured position - commanded node, both axes;
+//   probe       per axis the wall's place (the node + contact radius in the
+//               approach's direction, on the chord the perpendicular error
+//               puts the stylus on) minus the trip's commanded position, less
+//               half a servo period of travel (motion latches the command
+//               0 to 1 period after the contact). The trip is commanded up to
+//               the contact radius away from the node, so the error there is
+//               moved to the node through the field the readings themselves
+//               give (bilinear in the grid, iterated to a fixed point).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calibration/cell.h"
+#include "calibration/error_table.h"
+#include "calibration/measurement_plan.h"
+
+namespace smtcal::measure {
+
+// One reading of the log with what the plan says about its visit.
+struct Reading {
+  int visit = 0;
+  int node = 0;
+  int set = 1;
+  int repetition = 1;
+  MeasuredAxes axes = MeasuredAxes::kXY;
+  VisitKind kind = VisitKind::kNode;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();  // the node, commanded
+  double a = 0, b = 0;  // transducer: measuring, reference; probe: the trips' x, y
+  Eigen::Vector2d external = Eigen::Vector2d::Zero();  // external: the position measured
+  SourceRange where;  // its log line
+};
+
+// One error of one reading at its node.
+struct ReadingError {
+  TableAxis axis = TableAxis::X;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  VisitKind kind = VisitKind::kNode;
+  int set = 1;
+  int repetition = 1;
+  double error_mm = 0;
+  SourceRange where;
+};
+
+// The errors of `readings`, all of one region whose grid lines are `xs`,
+// `ys`, measured by `measure` with the robot's final approach and servo
+// period. For the probe `notes` gets how far the largest trip lay from its
+// node and how much moving it there changed the error.
+std::vector<ReadingError> ErrorsOfReadings(const cell::Measure& measure, const cell::Robot& robot,
+                                           const std::vector<double>& xs, const std::vector<double>& ys,
+                                           const std::vector<Reading>& readings, std::vector<std::string>& notes);
+
+// The plan file's digest (a 64-bit FNV-1a hash of its bytes with the
+// project's constants, 16 hex digits): the
+// measuring program writes it into its log, and `measure read` refuses a log
+// of another plan.
+std::string PlanDigest(std::string_view text);
+
+}  // namespace smtcal::measure

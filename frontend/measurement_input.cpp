@@ -1,0 +1,231 @@
+// The inputs of `smtcal measure program|read` (frontend/measurement_input.h).
+#include "frontend/measurement_input.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "base/field_text.h"
+#include "frontend/cad/cad_text.h"
+
+namespace smtcal::measure {
+namespace {
+
+constexpr std::string_view kLogMark = "# smtcal measuring log:";
+
+// "key VALUE" in a header of "; "-separated items.
+std::string Item(std::string_view header, std::string_view key) {
+  std::size_t at = 0;
+  while (at < header.size()) {
+    std::size_t end = header.find("; ", at);
+    if (end == std::string_view::npos) end = header.size();
+    std::string_view item = header.substr(at, end - at);
+    if (item.starts_with(key) && item.size() > key.size() && item[key.size()] == ' ') {
+      return std::string(item.substr(key.size() + 1));
+    }
+    at = end + 2;
+  }
+  return "";
+}
+
+}  // namespace
+
+std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, Diagnostics& diags) {
+  std::optional<std::vector<PlanRow>> rows = ReadMeasurementPlan(file, diags);
+  if (!rows) return std::nullopt;
+  const std::size_t errors_before = diags.error_count();
+  LoadedPlan loaded;
+  loaded.name = diags.sources().File(file).name;
+  loaded.file = file;
+  loaded.digest = PlanDigest(diags.sources().File(file).text);
+  Plan& plan = loaded.plan;
+  plan.cell_name = cell.name;
+  if (cell.measure) plan.device = cell.measure->device;
+  plan.approach_mm = cell.robot.final_approach_mm.value_or(Eigen::Vector2d::Zero());
+  std::map<int, const PlanRow*> node_at;
+  std::map<std::string, std::size_t> region_of;
+  for (std::size_t k = 0; k < rows->size(); ++k) {
+    const PlanRow& row = (*rows)[k];
+    if (row.visit != static_cast<int>(k) + 1) {
+      diags.Report(DiagKind::MeasurePlanVisitOrder, row.visit_field, row.visit, k);
+      return std::nullopt;
+    }
+    const bool transducer_rows = row.axes != MeasuredAxes::kXY;
+    if (cell.measure && transducer_rows != (cell.measure->device == cell::MeasureDevice::kTransducer)) {
+      diags.Report(DiagKind::MeasurePlanDevice, row.visit_field,
+                   transducer_rows ? "transducer" : "probe or external",
+                   cell::kMeasureDeviceNames[static_cast<std::size_t>(cell.measure->device)]);
+      return std::nullopt;
+    }
+    auto [first, fresh] = node_at.try_emplace(row.node, &row);
+    if (!fresh && first->second->at != row.at) {
+      Diagnostic* diag = diags.Report(DiagKind::MeasurePlanNodeMoved, row.node_field, row.node, FormatMm(row.at.x()),
+                                      FormatMm(row.at.y()), FormatMm(first->second->at.x()),
+                                      FormatMm(first->second->at.y()), first->second->line);
+      Diagnostics::AddNote(diag, first->second->node_field, "first given here");
+      continue;
+    }
+    auto [region_it, new_region] = region_of.try_emplace(AsciiLowercase(row.region), plan.regions.size());
+    if (new_region) {
+      PlanRegion region;
+      region.name = row.region;
+      if (const cell::Region* known = cell.FindRegion(row.region)) {
+        region.x_mm = known->x_mm;
+        region.y_mm = known->y_mm;
+        region.tolerance_mm = known->tolerance_mm;
+      } else {
+        // Not in the cell: one the plan proposed under a fixture's markers
+        // (FIXTURE_PATH), or a plan of another cell.
+        region.proposed = true;
+        std::vector<std::string> names;
+        bool marker = false;
+        for (const cell::Region& r : cell.regions) names.push_back(r.name);
+        for (const cell::Fixture& fixture : cell.fixtures) {
+          for (const cell::ScanPath& path : fixture.scan_paths) {
+            marker = marker || AsciiLowercase(fixture.name + "_" + path.name) == AsciiLowercase(row.region);
+          }
+        }
+        if (!marker) {
+          std::string closest = ClosestName(row.region, names);
+          diags.Report(DiagKind::MeasurePlanRegion, row.region_field, Printable(row.region), cell.name,
+                       closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
+          return std::nullopt;
+        }
+      }
+      plan.regions.push_back(region);
+    }
+    PlanRegion& region = plan.regions[region_it->second];
+    if (row.kind == VisitKind::kNode) {
+      if (std::find(region.xs.begin(), region.xs.end(), row.at.x()) == region.xs.end()) region.xs.push_back(row.at.x());
+      if (std::find(region.ys.begin(), region.ys.end(), row.at.y()) == region.ys.end()) region.ys.push_back(row.at.y());
+    }
+    region.sets = std::max(region.sets, row.set);
+    region.repetitions = std::max(region.repetitions, row.repetitions);
+    Visit visit;
+    visit.number = row.visit;
+    visit.region = region_it->second;
+    visit.axes = row.axes;
+    visit.station = row.station;
+    visit.kind = row.kind;
+    visit.node = row.node;
+    visit.at = row.at;
+    visit.set = row.set;
+    visit.repetitions = row.repetitions;
+    plan.visits.push_back(visit);
+    loaded.lines.push_back(row.line);
+  }
+  for (PlanRegion& region : plan.regions) {
+    std::sort(region.xs.begin(), region.xs.end());
+    std::sort(region.ys.begin(), region.ys.end());
+  }
+  if (diags.error_count() != errors_before) return std::nullopt;
+  return loaded;
+}
+
+std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPlan& plan, Diagnostics& diags) {
+  const std::size_t errors_before = diags.error_count();
+  const cad::Lines lines(diags.sources(), file);
+  MeasuringLog log;
+  log.name = diags.sources().File(file).name;
+  std::map<int, const Visit*> visits;
+  for (const Visit& visit : plan.plan.visits) visits[visit.number] = &visit;
+  for (std::uint32_t number = 1; number <= lines.count(); ++number) {
+    std::string_view line = lines.Text(number);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
+    const SourceRange where(lines.At(number, 0), static_cast<std::uint32_t>(line.size()));
+    if (log.blocks.empty() && !line.starts_with(kLogMark)) {
+      diags.Report(DiagKind::MeasureLogNotARun, SourceRange(lines.At(number, 0)), Printable(log.name));
+      return std::nullopt;
+    }
+    if (line.empty()) continue;
+    if (line.starts_with(kLogMark)) {
+      LogBlock block;
+      block.header = std::string(line.substr(2));
+      // "...: plan NAME digest HEX; ...; visits F..L"
+      const std::size_t digest_at = line.find(" digest ");
+      if (digest_at != std::string_view::npos) {
+        std::string_view rest = line.substr(digest_at + 8);
+        block.digest = std::string(rest.substr(0, rest.find(';')));
+      }
+      std::string range = Item(line, "visits");
+      std::size_t dots = range.find("..");
+      if (dots != std::string::npos) {
+        block.first_visit = std::atoi(range.substr(0, dots).c_str());
+        block.last_visit = std::atoi(range.substr(dots + 2).c_str());
+      }
+      if (block.digest != plan.digest) {
+        diags.Report(DiagKind::MeasureLogOtherPlan, where, block.digest.empty() ? "(none)" : block.digest, plan.digest,
+                     Printable(plan.name));
+        return std::nullopt;
+      }
+      log.blocks.push_back(block);
+      continue;
+    }
+    if (line == "# end") {
+      log.blocks.back().ended = true;
+      continue;
+    }
+    if (line.starts_with("# aborted")) {
+      log.blocks.back().stopped = std::string(line.substr(2));
+      continue;
+    }
+    if (line.starts_with("#") || line.starts_with("visit,")) continue;
+    // visit,node,set,repetition,x_mm,y_mm,a_mm,b_mm
+    std::vector<std::string_view> fields;
+    std::size_t at = 0;
+    while (true) {
+      std::size_t comma = line.find(',', at);
+      fields.push_back(line.substr(at, comma == std::string_view::npos ? std::string_view::npos : comma - at));
+      if (comma == std::string_view::npos) break;
+      at = comma + 1;
+    }
+    if (fields.size() != 8) {
+      diags.Report(DiagKind::CsvFieldCount, where, fmt::format("{} fields", fields.size()), 8,
+                   "visit,node,set,repetition,x_mm,y_mm,a_mm,b_mm");
+      continue;
+    }
+    std::array<double, 8> values{};
+    bool ok = true;
+    static constexpr std::array<std::string_view, 8> kColumns = {"visit", "node", "set", "repetition",
+                                                                 "x_mm",  "y_mm", "a_mm", "b_mm"};
+    std::uint32_t column = 0;
+    for (std::size_t f = 0; f < 8; ++f) {
+      std::optional<double> value = ParseNumber(fields[f]);
+      if (!value || !std::isfinite(*value)) {
+        diags.Report(DiagKind::CsvBadNumber, SourceRange(lines.At(number, column), static_cast<std::uint32_t>(fields[f].size())),
+                     Printable(fields[f]), kColumns[f], "");
+        ok = false;
+      }
+      values[f] = value.value_or(0);
+      column += static_cast<std::uint32_t>(fields[f].size()) + 1;
+    }
+    if (!ok) continue;
+    Reading reading;
+    reading.visit = static_cast<int>(values[0]);
+    reading.node = static_cast<int>(values[1]);
+    reading.set = static_cast<int>(values[2]);
+    reading.repetition = static_cast<int>(values[3]);
+    reading.at = Eigen::Vector2d(values[4], values[5]);
+    reading.a = values[6];
+    reading.b = values[7];
+    reading.where = where;
+    auto visit = visits.find(reading.visit);
+    if (visit == visits.end() || visit->second->node != reading.node) {
+      diags.Report(DiagKind::MeasureLogUnknownVisit, where, reading.visit, reading.node,
+                   visit == visits.end() ? fmt::format("{} visits", plan.plan.visits.size())
+                                         : fmt::format("node {} there", visit->second->node));
+      continue;
+    }
+    reading.axes = visit->second->axes;
+    reading.kind = visit->second->kind;
+    reading.at = visit->second->at;  // the plan's exact node (the log has 6 decimals)
+    log.readings.push_back(reading);
+    log.block_of.push_back(static_cast<int>(log.blocks.size()) - 1);
+  }
+  if (diags.error_count() != errors_before) return std::nullopt;
+  return log;
+}
+
+}  // namespace smtcal::measure

@@ -1,0 +1,54 @@
+// The inputs of `smtcal measure program|read` (docs/measure.md): a plan file
+// checked against its cell, and the measuring program's logs.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "calibration/cell.h"
+#include "calibration/measurement_plan.h"
+#include "calibration/measurement_reading.h"
+#include "frontend/table_csv.h"
+
+namespace smtcal::measure {
+
+// A plan file read back: the visits as written, the regions' grids from its
+// node rows, its digest. Reports (in the plan file): visits not numbered
+// 1, 2, 3, ..., a node number at two points, a plan of another device than
+// the cell's ([measure] device), and everything ReadMeasurementPlan does.
+struct LoadedPlan {
+  Plan plan;
+  std::string digest;  // PlanDigest of the file's text
+  std::string name;    // the file's name as given
+  std::uint32_t file = 0;  // its SourceManager id
+  std::vector<std::uint32_t> lines;  // per visit: its line in the file
+};
+std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, Diagnostics& diags);
+
+// The log a measuring program writes (LOGOPEN/LOGAPPEND): blocks, each
+//   # smtcal measuring log: plan NAME digest HEX; program STEM; region R; axes A; station S; device D; visits F..L
+//   visit,node,set,repetition,x_mm,y_mm,a_mm,b_mm
+//   1,1,1,1,150.000000,60.000000,0.512000,0.500000
+//   ...
+//   # end                       (or "# aborted at visit ..." before an abort)
+struct LogBlock {
+  std::string header;  // the first line, without "# "
+  std::string digest;
+  int first_visit = 0, last_visit = 0;
+  bool ended = false;  // "# end": the program ran to its end
+  std::string stopped;  // the "# aborted ..." line, when it stopped
+};
+struct MeasuringLog {
+  std::string name;
+  std::vector<LogBlock> blocks;
+  std::vector<Reading> readings;  // visit, node, set, repetition, at, a, b and where; the rest from the plan
+  std::vector<int> block_of;      // per reading: its block
+};
+// Reports a file that is no such log (MeasureLogNotARun), a block of
+// another plan (MeasureLogOtherPlan), bad lines (CsvBadNumber,
+// CsvFieldCount).
+std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPlan& plan, Diagnostics& diags);
+
+}  // namespace smtcal::measure

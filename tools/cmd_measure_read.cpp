@@ -1,0 +1,269 @@
+// `smtcal measure read PLAN.csv --cell CELL.toml LOG... -o RAW.csv`: the
+// measuring programs' logs (and an external system's readings) back into
+// the raw measurements `smtcal table build` averages, with where they came
+// from in the comments (frontend/measurement_input.h for the files,
+// calibration/measurement_reading.h for what a reading means). A visit the
+// logs lack is an error that names the visit to resume at. This file wires
+// the inputs, the checks across them and the exit codes.
+#include <filesystem>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "backend/reports/measurement_csv.h"
+#include "base/field_text.h"
+#include "frontend/measurement_input.h"
+#include "frontend/table_csv.h"
+#include "tools/commands.h"
+
+namespace smtcal::tools {
+namespace {
+
+struct ReadOptions {
+  std::string plan;
+  std::string cell;
+  std::vector<std::string> logs;
+  std::string external;
+  std::string region;
+  std::string output;
+};
+
+std::string BaseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// The readings of the logs, given in order: a block's readings replace those
+// of earlier blocks for the visits it covers (a resumed run appends a block
+// that starts at the visit the abort named).
+std::vector<measure::Reading> MergeReadings(const std::vector<measure::MeasuringLog>& logs, int& replaced) {
+  std::map<std::pair<int, int>, measure::Reading> by_key;  // (visit, repetition)
+  replaced = 0;
+  for (const measure::MeasuringLog& log : logs) {
+    for (const measure::LogBlock& block : log.blocks) {
+      for (auto it = by_key.begin(); it != by_key.end();) {
+        if (it->first.first >= block.first_visit && it->first.first <= block.last_visit) {
+          it = by_key.erase(it);
+          ++replaced;
+        } else {
+          ++it;
+        }
+      }
+      const int index = static_cast<int>(&block - log.blocks.data());
+      for (std::size_t k = 0; k < log.readings.size(); ++k) {
+        if (log.block_of[k] != index) continue;
+        by_key[{log.readings[k].visit, log.readings[k].repetition}] = log.readings[k];
+      }
+    }
+  }
+  std::vector<measure::Reading> readings;
+  for (auto& [key, reading] : by_key) readings.push_back(reading);
+  return readings;
+}
+
+void RunRead(const ReadOptions& opt, GlobalOptions& options) {
+  std::vector<NamedFile> inputs;
+  for (const std::string& log : opt.logs) inputs.push_back({"LOG", log});
+  inputs.push_back({"PLAN", opt.plan});
+  inputs.push_back({"--cell", opt.cell});
+  inputs.push_back({"--external", opt.external});
+  if (FilesClash(inputs, {{"-o", opt.output}})) {
+    options.exit_code = kExitUsageError;
+    return;
+  }
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<cell::Cell> cell;
+  std::optional<measure::LoadedPlan> plan;
+  if (!LoadMeasurePlan(opt.plan, opt.cell, sources, diags, options, cell, plan)) return;
+  const std::uint32_t plan_file = plan->file;
+  // The region.
+  std::optional<std::size_t> region;
+  if (opt.region.empty() && plan->plan.regions.size() == 1) region = 0;
+  for (std::size_t r = 0; r < plan->plan.regions.size(); ++r) {
+    if (!opt.region.empty() && AsciiLowercase(plan->plan.regions[r].name) == AsciiLowercase(opt.region)) region = r;
+  }
+  if (!region) {
+    std::string names;
+    for (const measure::PlanRegion& r : plan->plan.regions) names += (names.empty() ? "" : ", ") + r.name;
+    options.exit_code = ReportUsageError(fmt::format(
+        "{}: name the region to read with --region (the plan has {})",
+        opt.region.empty() ? "the plan measures several regions" : "--region " + opt.region + " is not in the plan",
+        names));
+    return;
+  }
+  const measure::PlanRegion& grid = plan->plan.regions[*region];
+  // The logs.
+  std::vector<measure::MeasuringLog> logs;
+  for (const std::string& path : opt.logs) {
+    Result<std::uint32_t> file = sources.Load(path);
+    if (!file) {
+      options.exit_code = ReportIoError(file.error());
+      return;
+    }
+    if (std::optional<measure::MeasuringLog> log = measure::ReadMeasuringLog(file.value(), *plan, diags)) {
+      logs.push_back(std::move(*log));
+    }
+  }
+  if (diags.has_errors()) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
+  int replaced = 0;
+  std::vector<measure::Reading> all = MergeReadings(logs, replaced);
+  std::map<std::pair<int, int>, measure::Reading*> by_key;
+  for (measure::Reading& reading : all) by_key[{reading.visit, reading.repetition}] = &reading;
+  // Every reading the plan asks for in the region, in plan order.
+  std::vector<measure::Reading> readings;
+  std::string resume;
+  for (std::size_t k = 0; k < plan->plan.visits.size(); ++k) {
+    const measure::Visit& visit = plan->plan.visits[k];
+    if (visit.region != *region) continue;
+    for (int rep = 1; rep <= visit.repetitions; ++rep) {
+      auto it = by_key.find({visit.number, rep});
+      if (it != by_key.end()) {
+        readings.push_back(*it->second);
+        continue;
+      }
+      if (!diags.has_errors()) {
+        std::string stopped;
+        for (const measure::MeasuringLog& log : logs) {
+          for (const measure::LogBlock& block : log.blocks) {
+            if (visit.number >= block.first_visit && visit.number <= block.last_visit && !block.stopped.empty()) {
+              stopped = fmt::format(" ({} says: {})", BaseName(log.name), block.stopped);
+            }
+          }
+        }
+        diags.Report(DiagKind::MeasureLogIncomplete,
+                     SourceRange(SourceLoc{plan_file, plan->lines[k], 1}), visit.number, visit.node, grid.name,
+                     FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set, rep, stopped, BaseName(opt.plan),
+                     visit.number);
+      }
+    }
+  }
+  const cell::Measure& device = *cell->measure;
+  if (device.device == cell::MeasureDevice::kTransducer) {
+    for (const measure::Reading& r : readings) {
+      for (double value : {r.a, r.b}) {
+        if (device.transducer.range_mm.Contains(value)) continue;
+        diags.Report(DiagKind::MeasureReadingOutOfRange, r.where, FormatMm(value), FormatMm(device.transducer.range_mm.lo),
+                     FormatMm(device.transducer.range_mm.hi), r.visit);
+        break;
+      }
+    }
+  }
+  if (device.device == cell::MeasureDevice::kExternal) {
+    if (opt.external.empty()) {
+      options.exit_code =
+          ReportUsageError("the device is external: give its readings with --external READINGS.csv");
+      return;
+    }
+    Result<std::uint32_t> file = sources.Load(opt.external);
+    if (!file) {
+      options.exit_code = ReportIoError(file.error());
+      return;
+    }
+    std::optional<std::vector<ExternalReading>> external = ReadExternalReadings(file.value(), diags);
+    if (external) {
+      std::map<std::tuple<long long, long long, long long>, const ExternalReading*> found;
+      for (const ExternalReading& e : *external) {
+        auto [it, fresh] = found.try_emplace({e.node, e.set, e.repetition}, &e);
+        if (!fresh) diags.Report(DiagKind::MeasureExternalDuplicate, e.range, e.node, e.set, e.repetition, it->second->line);
+      }
+      std::set<std::tuple<long long, long long, long long>> used;
+      for (const measure::Reading& r : all) used.insert({r.node, r.set, r.repetition});
+      for (measure::Reading& r : readings) {
+        auto it = found.find({r.node, r.set, r.repetition});
+        if (it == found.end()) {
+          diags.Report(DiagKind::MeasureExternalMissing, r.where, r.node, r.set, r.repetition, r.visit,
+                       r.where.begin.line);
+          continue;
+        }
+        r.external = it->second->at;
+      }
+      for (const ExternalReading& e : *external) {
+        if (!used.contains({e.node, e.set, e.repetition})) {
+          diags.Report(DiagKind::MeasureExternalUnknown, e.range, e.node, e.set, e.repetition);
+        }
+      }
+    }
+  }
+  if (diags.has_errors()) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
+  std::vector<std::string> notes;
+  std::vector<measure::ReadingError> errors =
+      measure::ErrorsOfReadings(device, cell->robot, grid.xs, grid.ys, readings, notes);
+  std::vector<RawMeasurement> rows;
+  std::vector<bool> checks;
+  for (const measure::ReadingError& e : errors) {
+    RawMeasurement m;
+    m.axis = e.axis;
+    m.x_mm = e.at.x();
+    m.y_mm = e.at.y();
+    m.set = e.set;
+    m.repetition = e.repetition;
+    m.error_mm = e.error_mm;
+    rows.push_back(m);
+    checks.push_back(e.kind == measure::VisitKind::kCheck);
+  }
+  // Axis x first, then y, each in plan order (a stable sort keeps it).
+  std::vector<std::size_t> order(rows.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return rows[a].axis < rows[b].axis; });
+  std::vector<RawMeasurement> sorted;
+  std::vector<bool> sorted_checks;
+  for (std::size_t k : order) {
+    sorted.push_back(rows[k]);
+    sorted_checks.push_back(checks[k]);
+  }
+  std::vector<std::string> comment;
+  comment.push_back(fmt::format("Raw position-error measurements of region {} of cell '{}', read by smtcal measure read",
+                                grid.name, cell->name));
+  comment.push_back(fmt::format("plan {} (digest {}); cell {}; device {}", BaseName(opt.plan), plan->digest,
+                                BaseName(opt.cell), cell::kMeasureDeviceNames[static_cast<std::size_t>(device.device)]));
+  for (const measure::MeasuringLog& log : logs) {
+    for (const measure::LogBlock& block : log.blocks) {
+      comment.push_back(fmt::format("log {}: visits {}..{}{}", BaseName(log.name), block.first_visit, block.last_visit,
+                                    block.ended ? ", ran to its end" : block.stopped.empty() ? ", stopped" : ", " + block.stopped));
+    }
+  }
+  if (!opt.external.empty()) comment.push_back(fmt::format("external readings {}", BaseName(opt.external)));
+  if (replaced > 0) {
+    comment.push_back(fmt::format("{} reading{} of a stopped run replaced by the resumed run's", replaced,
+                                  replaced == 1 ? "" : "s"));
+  }
+  for (const std::string& note : notes) comment.push_back(note);
+  comment.push_back(fmt::format("Build the table: smtcal table build {} -o TABLE.csv", BaseName(opt.output)));
+  Status written = WriteFileAtomically(opt.output, FormatRawCsv(sorted, sorted_checks, comment));
+  if (!written) {
+    options.exit_code = ReportIoError(written.error());
+    return;
+  }
+  options.exit_code = PrintDiagnostics(diags, options);
+  SayDone(options, opt.output,
+          fmt::format("wrote {} ({} readings of region {}{})", opt.output, readings.size(), grid.name,
+                      replaced > 0 ? fmt::format("; {} of a stopped run replaced", replaced) : ""));
+}
+
+}  // namespace
+
+void AddMeasureReadCommand(CLI::App& measure, GlobalOptions& options) {
+  static ReadOptions opt;
+  CLI::App* read = measure.add_subcommand(
+      "read",
+      "Read the measuring programs' logs (and an external system's readings) back into the raw measurements of\n"
+      "one region (axis,x_mm,y_mm,set,repetition,error_mm[,kind]) for smtcal table build, with where they came\n"
+      "from in the comments. A visit no log has is an error naming the visit to resume at");
+  read->add_option("PLAN", opt.plan, "the plan the programs were made from")->required();
+  read->add_option("LOG", opt.logs, "the logs the programs wrote, in the order they ran")->required();
+  read->add_option("--cell", opt.cell, "the cell file ([measure] says what a reading means)")->required();
+  read->add_option("--region", opt.region, "the region to read (needed when the plan has several)");
+  read->add_option("--external", opt.external,
+                   "the external system's readings: node,set,repetition,x_mm,y_mm (device external)");
+  read->add_option("-o,--output", opt.output, "the raw measurement CSV to write ('-' for stdout)")->required();
+  read->callback([&options] { RunRead(opt, options); });
+}
+
+}  // namespace smtcal::tools
