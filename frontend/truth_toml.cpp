@@ -106,19 +106,15 @@ class Reader {
     CheckKeys(table, "[drift]",
               {"start_cycle", "board_mm_per_cycle", "board_deg_per_cycle", "robot_scale_ppm_per_cycle",
                "robot_scale_about_mm", "sensor_threshold_mm_per_cycle", "sensor_accuracy_mm_per_cycle"});
-    if (std::optional<double> start = Number(table, "start_cycle", 0, 1e6, "")) {
+    if (std::optional<double> start = Number(table, "start_cycle", Whole(0, 1e6))) {
       drift.start_cycle = static_cast<long>(*start);
-      if (*start != std::floor(*start)) {
-        diags_.Report(DiagKind::TruthBadValue, Range(*table.get("start_cycle")), "start_cycle",
-                      "a whole number of cycles", fmt::format("{}", *start));
-      }
     }
     drift.board_mm_per_cycle = Point(table, "board_mm_per_cycle", 0.1).value_or(drift.board_mm_per_cycle);
-    drift.board_deg_per_cycle = Number(table, "board_deg_per_cycle", -0.01, 0.01, "deg").value_or(0);
-    drift.robot_scale_ppm_per_cycle = Number(table, "robot_scale_ppm_per_cycle", -100, 100, "ppm").value_or(0);
+    drift.board_deg_per_cycle = Number(table, "board_deg_per_cycle", Closed(-0.01, 0.01, "deg")).value_or(0);
+    drift.robot_scale_ppm_per_cycle = Number(table, "robot_scale_ppm_per_cycle", Closed(-100, 100, "ppm")).value_or(0);
     drift.robot_scale_about_mm = Point(table, "robot_scale_about_mm", 1e5).value_or(drift.robot_scale_about_mm);
-    drift.sensor_threshold_mm_per_cycle = Number(table, "sensor_threshold_mm_per_cycle", -0.01, 0.01, "mm").value_or(0);
-    drift.sensor_accuracy_mm_per_cycle = Number(table, "sensor_accuracy_mm_per_cycle", 0, 0.01, "mm").value_or(0);
+    drift.sensor_threshold_mm_per_cycle = Number(table, "sensor_threshold_mm_per_cycle", Closed(-0.01, 0.01, "mm")).value_or(0);
+    drift.sensor_accuracy_mm_per_cycle = Number(table, "sensor_accuracy_mm_per_cycle", Closed(0, 0.01, "mm")).value_or(0);
   }
 
   void ReadRegion(const toml::table& table, TruthSpec& spec) {

@@ -10,6 +10,7 @@
 #include "base/field_text.h"
 #include "base/json_text.h"
 #include "calibration/cycle_monitor.h"
+#include "calibration/limits.h"
 #include "frontend/cell_toml.h"
 #include "frontend/record_log.h"
 #include "tools/commands.h"
@@ -21,6 +22,7 @@ struct MonitorCommandOptions {
   std::vector<std::string> logs;
   std::string cell_path;
   MonitorOptions monitor;
+  int baseline = static_cast<int>(MonitorOptions{}.baseline);  // --baseline, into monitor.baseline
   bool json = false;
   std::string svg_path;
   bool exit_zero = false;
@@ -80,13 +82,15 @@ const LoggedCycle* NthOf(const RecordLog& log, std::string_view fixture, long n)
   return nullptr;
 }
 
-void RunMonitor(const MonitorCommandOptions& opt, GlobalOptions& options) {
-  std::vector<std::string> inputs = opt.logs;
-  inputs.push_back(opt.cell_path);
-  if (OutputOverwritesInput("--svg", opt.svg_path, inputs)) {
+void RunMonitor(MonitorCommandOptions& opt, GlobalOptions& options) {
+  std::vector<NamedFile> inputs;
+  for (const std::string& log : opt.logs) inputs.push_back({"LOG", log});
+  inputs.push_back({"--cell", opt.cell_path});
+  if (FilesClash(inputs, {{"--svg", opt.svg_path}, {"the report", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
+  opt.monitor.baseline = static_cast<std::size_t>(opt.baseline);
   SourceManager sources;
   Diagnostics diags(sources);
   Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell_path, sources, diags);
@@ -161,9 +165,9 @@ void AddMonitorCommand(CLI::App& app, GlobalOptions& options) {
       "drifts and what to do, process figures; exit 1 when the cell is out of control");
   monitor->add_option("LOG", opt.logs, "the logs of cycle records, oldest first (docs/monitor.md)")->required();
   monitor->add_option("--cell", opt.cell_path, "the cell file the records were made with (*.cell.toml)")->required();
-  monitor->add_option("--baseline", opt.monitor.baseline,
-                      "the first accepted scans of each fixture that set the charts' centre lines and sigmas")
-      ->check(CLI::Range(2, 1'000'000))
+  AddNumberOption(*monitor, "--baseline", opt.baseline,
+                  "the first accepted scans of each fixture that set the charts' centre lines and sigmas",
+                  limits::kMonitorBaseline)
       ->capture_default_str();
   monitor->add_flag("--json", opt.json, "print the report as JSON (docs/monitor.md) instead of text");
   monitor->add_option("--svg", opt.svg_path, "also draw the control charts to this SVG file");
