@@ -59,7 +59,12 @@ Case MakeCase(std::mt19937_64& rng) {
   } else if (fault < 0.3) {
     *c.trips[k] += Eigen::Vector2d(Uniform(rng, -0.3, 0.3), Uniform(rng, -0.3, 0.3));
   }
-  if (Uniform(rng, 0, 1) < 0.5) c.previous = PlanarFix(FixOrigin(truth) + Eigen::Vector2d(0.1, -0.2), FixAngleRad(truth));
+  // A previous scan half the time; one in five of those farther than
+  // max_shift_mm (2 mm) from this one, so cycle_shift refuses some scans.
+  if (Uniform(rng, 0, 1) < 0.5) {
+    const Eigen::Vector2d moved = Uniform(rng, 0, 1) < 0.2 ? Eigen::Vector2d(2.5, 0) : Eigen::Vector2d(0.1, -0.2);
+    c.previous = PlanarFix(FixOrigin(truth) + moved, FixAngleRad(truth));
+  }
   c.cell.name = "paper cell";  // a name the record writes as paper_cell
   c.cell.fixtures.push_back(fixture);
   return c;
