@@ -543,7 +543,8 @@ void RunHarness(std::mt19937_64& rng, cell::Estimator estimator, int cases, int 
       for (std::size_t c = 0; c < want.checks.size(); ++c) {
         ASSERT_EQ(got.checks[c].has_value(), want.checks[c].has_value()) << "check " << c + 1;
         if (want.checks[c]) {
-          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), 5.000001e-7) << "check " << c + 1;
+          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), 5.000001e-7)
+              << "check " << c + 1 << ": recorded " << *got.checks[c] << ", C++ " << *want.checks[c];
         }
       }
       ASSERT_EQ(got.estimate.has_value(), want.estimate.has_value());
