@@ -20,7 +20,10 @@
 namespace smtcal {
 
 // The format version a begin line states (runtime/c's SMTCAL_RECORD_FORMAT).
-inline constexpr int kRecordFormat = 1;
+// 2: the LinuxCNC runtime writes lengths and angles in millionths followed by
+// e-6, since LinuxCNC prints a number below 1e-4 as 0; the logs of format 1
+// hold such values as 0 and are refused (docs/monitor.md).
+inline constexpr int kRecordFormat = 2;
 
 struct CycleRecord {
   int fixture = 0;   // index into the begin line's fixtures

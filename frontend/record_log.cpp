@@ -193,7 +193,14 @@ class Reader {
     const std::optional<long> version = Whole(tokens[1], "the format version", 1, 1'000'000);
     if (!version) return false;
     if (*version != kRecordFormat) {
-      diags_.Report(DiagKind::RecordVersion, At(tokens[1]), *version, kRecordFormat);
+      // Format 1's LinuxCNC runtime wrote every value below 1e-4 mm or deg
+      // as 0 (a kinder number than was measured), and its logs cannot say
+      // which runtime wrote them.
+      diags_.Report(DiagKind::RecordVersion, At(tokens[1]), *version, kRecordFormat,
+                    *version == 1 ? "in format 1 the LinuxCNC runtime wrote every value below 1e-4 mm or deg as 0, "
+                                    "so small residuals and deltas read as zero; recompile the program with this "
+                                    "smtcal and record again"
+                                  : "read it with the smtcal that matches the controller's runtime");
       return false;
     }
     RecordBegin& begin = logged.begin;

@@ -41,9 +41,10 @@ struct SimulateOptions {
   SimOptions sim;
 };
 
-// The decimals of a simulated record: the LinuxCNC runtime's (%.6f), so a
-// simulated log reads like a controller's.
-constexpr int kRecordDecimals = 6;
+// The decimals of a simulated record: 1e-9 mm or deg, finer than anything
+// the simulation models, in the plain decimals of the C runtime's formatter
+// (the LinuxCNC runtime writes millionths and e-6, to 1e-15; docs/monitor.md).
+constexpr int kRecordDecimals = 9;
 
 // The improved mode's scans as the controller would log them (docs/monitor.md).
 Status WriteRecord(const std::string& path, const SimResult& result, const cell::Cell& cell,

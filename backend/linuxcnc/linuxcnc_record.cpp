@@ -42,6 +42,18 @@ std::string Header(std::string_view file, const cell::Cell& cell, std::string_vi
 // A parameter of the buffer the LOG comments print.
 int Buffer(int offset) { return L::kRecordBuffer + offset; }
 
+// LinuxCNC 2.9 prints every number below 1e-4 in magnitude as 0, whatever
+// the format (found with rs274: 0.00009 prints 0.000000, 0.0001 0.000100),
+// and at most 9 decimals. So the record's lengths (mm) and angles (deg) are
+// printed in millionths with 9 decimals, and the text e-6 after each makes
+// it the value in mm or deg again: 0.000023 deg is written
+// 23.000000000e-6. A value below 1e-10 reads as 0, every other one to
+// 1e-15 (docs/monitor.md). A LOG comment's format holds for the numbers
+// after it, so each line names it once, before its first scaled number.
+constexpr int kLogScale = 1000000;
+constexpr std::string_view kLogFormat = "%.9f";
+std::string Scaled(int parameter) { return fmt::format("#{}e-6", parameter); }
+
 }  // namespace
 
 std::string LinuxCncRecordSecondFile(std::string_view record_file) { return std::string(record_file) + ".1"; }
@@ -135,13 +147,17 @@ std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program)
   out += "  " + BeginComment(cell, program) + "\n";
   out += "o<smtcal_rec_full> endif\n";
   out += fmt::format("#{0} = [#{0} + 1]\n", L::kRecordCount);
-  // The buffer: fixture, cycle, status, trip, time, S1..S3, the checks.
+  // The buffer: fixture, cycle, status, trip, time, S1..S3, the checks; the
+  // lengths and angles in millionths (kLogScale).
   out += fmt::format("#{} = #<k>\n", Buffer(0));
   out += fmt::format("#{} = #[#<f> + {}]\n", Buffer(1), L::kFxRecordCycles);
   out += fmt::format("#{} = #[#<f> + {}]\n", Buffer(2), L::kFxStatus);
   out += fmt::format("#{} = [#[#<f> + {}] + 1]\n", Buffer(3), L::kFxFailedTrip);
-  for (int i = 0; i < 6; ++i) out += fmt::format("#{} = #[#<f> + {}]\n", Buffer(5 + i), L::kFxS + i);
-  for (int c = 1; c <= 11; ++c) out += fmt::format("#{} = #[#<f> + {}]\n", Buffer(10 + c), L::kFxCheckValue + c);
+  for (int i = 0; i < 6; ++i) out += fmt::format("#{} = [#[#<f> + {}] * {}]\n", Buffer(5 + i), L::kFxS + i, kLogScale);
+  out += fmt::format("#{} = #[#<f> + {}]  ; missing_trip counts trips\n", Buffer(11), L::kFxCheckValue + 1);
+  for (int c = 2; c <= 11; ++c) {
+    out += fmt::format("#{} = [#[#<f> + {}] * {}]\n", Buffer(10 + c), L::kFxCheckValue + c, kLogScale);
+  }
   const std::string head = fmt::format("%d#{} #{}", Buffer(0), Buffer(1));
   const std::string time = linuxcnc.record_clock_pin.empty()
                                ? std::string(" -")
@@ -150,15 +166,18 @@ std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program)
   out += fmt::format("o<smtcal_rec_pose> if [#[#<f> + {}] EQ 1 AND #[#<f> + {}] EQ 0]\n", L::kFxCheckEvaluated + 3,
                      L::kFxCheckValue + 3);
   std::string s;
-  for (int i = 0; i < 6; ++i) s += fmt::format(" {}#{}", i == 0 && linuxcnc.record_clock_pin.empty() ? "%.6f" : "", Buffer(5 + i));
+  for (int i = 0; i < 6; ++i) s += fmt::format(" {}{}", i == 0 ? kLogFormat : "", Scaled(Buffer(5 + i)));
   out += fmt::format("  (LOG,cycle {} #{} #{}{}{})\n", head, Buffer(2), Buffer(3), time, s);
   out += "o<smtcal_rec_pose> else\n";
   out += fmt::format("  (LOG,cycle {} #{} #{}{} - - - - - -)\n", head, Buffer(2), Buffer(3), time);
   out += "o<smtcal_rec_pose> endif\n";
   // The checks that ran: 1; 1, 2; 1..3; 1..9; 1..11 (docs/periphery.md).
+  // Check 1 is a count of trips (%d, as the head); the others are scaled.
   auto checks = [&](int ran) {
-    std::string line = fmt::format("(LOG,checks {} %.6f", head);
-    for (int c = 1; c <= 11; ++c) line += c <= ran ? fmt::format("{}#{}", c == 1 ? "" : " ", Buffer(10 + c)) : " -";
+    std::string line = fmt::format("(LOG,checks {} #{}", head, Buffer(11));
+    for (int c = 2; c <= 11; ++c) {
+      line += c <= ran ? fmt::format(" {}{}", c == 2 ? kLogFormat : "", Scaled(Buffer(10 + c))) : " -";
+    }
     return line + ")";
   };
   out += fmt::format("o<smtcal_rec_checks> if [#[#<f> + {}] EQ 1]\n", L::kFxCheckEvaluated + 11);
@@ -180,9 +199,10 @@ std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program)
   out += "o<smtcal_rec_trips> while [#<i> LT #<count>]\n";
   out += fmt::format("  #{} = [#<i> + 1]\n", Buffer(24));
   out += "  o<smtcal_rec_made> if [#[#<tripped> + #<i>] EQ 1]\n";
-  out += fmt::format("    #{} = #[#<trips> + 2 * #<i>]\n", Buffer(22));
-  out += fmt::format("    #{} = #[#<trips> + 2 * #<i> + 1]\n", Buffer(23));
-  out += fmt::format("    (LOG,trip {} #{} %.6f#{} #{})\n", head, Buffer(24), Buffer(22), Buffer(23));
+  out += fmt::format("    #{} = [#[#<trips> + 2 * #<i>] * {}]\n", Buffer(22), kLogScale);
+  out += fmt::format("    #{} = [#[#<trips> + 2 * #<i> + 1] * {}]\n", Buffer(23), kLogScale);
+  out += fmt::format("    (LOG,trip {} #{} {}{} {})\n", head, Buffer(24), kLogFormat, Scaled(Buffer(22)),
+                     Scaled(Buffer(23)));
   out += "  o<smtcal_rec_made> else\n";
   out += fmt::format("    (LOG,trip {} #{} - -)\n", head, Buffer(24));
   out += "  o<smtcal_rec_made> endif\n";

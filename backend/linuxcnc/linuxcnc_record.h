@@ -10,8 +10,11 @@
 // open the log in the task, and every (LOG,...) comment is one fprintf of a
 // whole line and an fflush: a line is complete in the file or absent, even
 // when the program is aborted. A LOG comment expands its parameters into a
-// 512-byte buffer that LinuxCNC does not bound, so a line prints at most 16
-// numbers (each at most 29 characters): hence a record of several lines.
+// 512-byte buffer that LinuxCNC does not bound, so a line prints at most 13
+// numbers (each at most 29 characters and its e-6): hence a record of
+// several lines. LinuxCNC prints a number below 1e-4 as 0, so lengths and
+// angles are printed in millionths with the text e-6 after them (format 2,
+// docs/monitor.md): every value to 1e-10 mm or deg.
 // The log is kept in two files, record_file and record_file.1: when one holds
 // record_max_cycles scans the runtime empties the other and goes on there
 // (the counters in #4996..#4999, which the machine's parameter file must

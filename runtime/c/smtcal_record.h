@@ -34,7 +34,7 @@
 extern "C" {
 #endif
 
-#define SMTCAL_RECORD_FORMAT 1        /* the format version the begin line states */
+#define SMTCAL_RECORD_FORMAT 2        /* the format version the begin line states */
 /* Room for the text of any record (32 trips: 34 lines) written with
  * decimals -1, or with 0..17 decimals and every value below 1e9 in
  * magnitude. */

@@ -738,13 +738,14 @@ def read_record_log(path):
 
 def check_record_log(path, latched, verdicts, clock):
     """One record per scan, each what `smtcal fixture` made of the trips
-    LinuxCNC latched: the trips to the 6 decimals the runtime writes, the
-    verdict, S1..S3 and every check's value."""
+    LinuxCNC latched: the trips to 1e-9 mm (the runtime writes millionths
+    and e-6, since LinuxCNC prints a number below 1e-4 as 0), the verdict,
+    S1..S3 and every check's value."""
     if not os.path.exists(path):
         fail(f"the runtime wrote no cycle record ({path})")
     begins, records = read_record_log(path)
-    if len(begins) != 1 or begins[0][1] != "1" or "fixtures=Board:8" not in begins[0]:
-        fail(f"expected one begin line of format 1 naming Board:8, got {begins}")
+    if len(begins) != 1 or begins[0][1] != "2" or "fixtures=Board:8" not in begins[0]:
+        fail(f"expected one begin line of format 2 naming Board:8, got {begins}")
     if len(records) != len(verdicts):
         fail(f"{len(records)} records for {len(verdicts)} scans")
     worst = 0.0
@@ -767,17 +768,17 @@ def check_record_log(path, latched, verdicts, clock):
         else:
             got = [float(v) for v in c[6:]]
             want = [v for s in verdict["s_mm"] for v in s]
-            if max(abs(a - b) for a, b in zip(got, want)) > 2e-6:
+            if max(abs(a - b) for a, b in zip(got, want)) > 1e-8:
                 fail(f"record {n + 1}: S1..S3 {got}, smtcal fixture {want}")
         for k, check in enumerate(verdict["checks"]):
             value = rec["checks"][3 + k]
             if not check["evaluated"]:
                 if value != "-":
                     fail(f"record {n + 1}: check {check['name']} did not run but is recorded as {value}")
-            elif value == "-" or abs(float(value) - check["value"]) > 2e-6:
+            elif value == "-" or abs(float(value) - check["value"]) > 1e-8:
                 fail(f"record {n + 1}: check {check['name']} recorded {value}, smtcal fixture {check['value']}")
-    if worst > 5.0001e-7:
-        fail(f"a recorded trip is {worst} mm from what LinuxCNC latched (6 decimals: 5e-7)")
+    if worst > 1e-9:
+        fail(f"a recorded trip is {worst} mm from what LinuxCNC latched (the record keeps 1e-10)")
     log(f"  cycle record: {len(records)} records, one per scan, each smtcal fixture's verdict and values; trips "
         f"within {worst:.1e} mm of what LinuxCNC latched ({os.path.getsize(path)} bytes)")
 

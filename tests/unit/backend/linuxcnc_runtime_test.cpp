@@ -8,7 +8,9 @@
 // the first placement; the example cell's data loads; a replacement
 // smtcal_probe_trips.ngc earlier on the subroutine path supplies trips. The
 // cycle record every scan leaves (LOG lines, docs/monitor.md) is read back
-// with smtcal's reader and equals the C++ scan to its 6 decimals.
+// with smtcal's reader and equals the C++ scan to 1e-10 mm or deg, small
+// values included (LinuxCNC prints a number below 1e-4 as 0: the record
+// writes millionths).
 #include <unistd.h>
 
 #include <cmath>
@@ -55,6 +57,11 @@ using test::Uniform;
 // (the C runtime's test allows 1e-9 mm).
 constexpr double kAgreeMm = 1e-11;
 constexpr double kPrintScale = 1e6;
+// A cycle record's value against C++: the record prints millionths with 9
+// decimals, and LinuxCNC prints a number below 1e-4 as 0, so a value below
+// 1e-10 mm or deg reads as 0 (docs/monitor.md); rs274's arithmetic adds at
+// most kAgreeMm.
+constexpr double kRecordAgree = 1e-10 + kAgreeMm;
 
 const fs::path kPaperCell = fs::path(SMTCAL_SOURCE_DIR) / "examples" / "paper-cell" / "paper.cell.toml";
 
@@ -525,7 +532,7 @@ void RunHarness(std::mt19937_64& rng, cell::Estimator estimator, int cases, int 
     SCOPED_TRACE(fmt::format("case {} (fault {})", i, (first_fault + i) % kFaultCount));
     const ScanResult& cpp = expected[static_cast<std::size_t>(i)].scan;
     {
-      // The record: what C++ makes of the same trips, to the 6 decimals LinuxCNC writes.
+      // The record: what C++ makes of the same trips, to the record's resolution.
       const CycleRecord want = RecordOfScan(kHarnessFixture, i + 1, std::nullopt, cpp);
       const CycleRecord& got = log.cycles[static_cast<std::size_t>(i)].record;
       EXPECT_EQ(got.fixture, want.fixture);
@@ -537,19 +544,19 @@ void RunHarness(std::mt19937_64& rng, cell::Estimator estimator, int cases, int 
       for (std::size_t k = 0; k < want.trips.size(); ++k) {
         ASSERT_EQ(got.trips[k].has_value(), want.trips[k].has_value()) << "T" << k + 1;
         if (want.trips[k]) {
-          EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), 5.000001e-7);
+          EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), kRecordAgree);
         }
       }
       for (std::size_t c = 0; c < want.checks.size(); ++c) {
         ASSERT_EQ(got.checks[c].has_value(), want.checks[c].has_value()) << "check " << c + 1;
         if (want.checks[c]) {
-          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), 5.000001e-7)
+          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), kRecordAgree)
               << "check " << c + 1 << ": recorded " << *got.checks[c] << ", C++ " << *want.checks[c];
         }
       }
       ASSERT_EQ(got.estimate.has_value(), want.estimate.has_value());
       for (std::size_t k = 0; k < 3 && want.estimate; ++k) {
-        EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), 5.000001e-7);
+        EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), kRecordAgree);
       }
     }
     ASSERT_EQ(printed.scans.count(i), 1u) << run.out;
@@ -876,6 +883,68 @@ TEST(LinuxCncRuntime, CorrectRefusesUnscannedFixturesAndOutsidePoints) {
   EXPECT_NE(outside.err.find("outside the table of region 0 whose outside policy is error"), std::string::npos)
       << outside.err;
   for (const std::string& line : outside.canon) EXPECT_NE(line, "SET_AUX_OUTPUT_BIT(8)");
+}
+
+// LinuxCNC prints a number below 1e-4 as 0 whatever its format: a scan
+// that is almost perfect (the board 2.3e-5 deg and some 3e-5 mm off
+// nominal, trips within 5e-5 mm, the previous pose as close) has check
+// values that small, and its record must keep them, not write 0.
+TEST(LinuxCncRuntime, CycleRecordKeepsValuesLinuxCncWouldPrintAsZero) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  std::mt19937_64 rng(seed);
+  cell::Cell cell = HarnessCell(rng, cell::Estimator::kRigid);
+  cell.regions.clear();  // no table: the trips are where the board is
+  const cell::Fixture& fixture = cell.fixtures[kHarnessFixture];
+  const Workspace ws("small", cell);
+  const Eigen::Affine3d truth = PlanarFix(fixture.origin_mm + Eigen::Vector2d(3e-5, -2e-5),
+                                          (fixture.angle_deg + 2.3e-5) * kRadPerDeg);
+  std::vector<double> sensor;
+  std::vector<Eigen::Vector2d> robot;
+  for (std::size_t k = 0; k < ExpectedTrips(fixture).size(); ++k) {
+    sensor.push_back(Uniform(rng, -5e-5, 5e-5));
+    robot.emplace_back(0, 0);
+  }
+  std::vector<Eigen::Vector2d> trips = test::SimulateTrips(fixture, truth, sensor, robot);
+  for (Eigen::Vector2d& t : trips) t -= DirectCalibrateInCell(cell.regions, t) - t;
+  const std::vector<std::optional<Eigen::Vector2d>> present = test::Present(trips);
+  const Eigen::Affine3d previous =
+      PlanarFix(FixOrigin(truth) + Eigen::Vector2d(4e-5, 1e-5), FixAngleRad(truth) + 1e-5 * kRadPerDeg);
+  ScanOptions options;
+  options.estimator = fixture.estimator;
+  options.regions = &cell.regions;
+  options.previous = previous;
+  const ScanResult cpp = ScanFixture(fixture, present, options);
+  ASSERT_EQ(cpp.FirstFailure(), nullptr);
+  const test::Rs274Result run = ws.Run(ProgramStart() + SetTrips(kHarnessFixture, present) +
+                                       SetPrevious(kHarnessFixture, previous) +
+                                       fmt::format("o<smtcal_estimate> call [{}]\n", kHarnessFixture) + ProgramEnd());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  SourceManager sources;
+  Diagnostics diags(sources);
+  RecordLog log;
+  const std::string logged = LoggedText(run);
+  ASSERT_TRUE(ReadRecordLog(sources.Add("small.log", logged), log, diags)) << diags.RenderText() << logged;
+  ASSERT_EQ(log.cycles.size(), 1u) << logged;
+  const CycleRecord want = RecordOfScan(kHarnessFixture, 1, std::nullopt, cpp);
+  const CycleRecord& got = log.cycles[0].record;
+  int small = 0;  // check values LinuxCNC alone would print as 0
+  for (std::size_t c = 0; c < want.checks.size(); ++c) {
+    ASSERT_TRUE(want.checks[c].has_value()) << "check " << c + 1;
+    ASSERT_TRUE(got.checks[c].has_value()) << "check " << c + 1;
+    EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), kRecordAgree)
+        << "check " << c + 1 << ": recorded " << *got.checks[c] << ", C++ " << *want.checks[c] << "\n" << logged;
+    if (std::abs(*want.checks[c]) > 1e-9 && std::abs(*want.checks[c]) < 1e-4) ++small;
+  }
+  // nominal_rotation, cycle_shift, cycle_rotation and the line residuals at least.
+  EXPECT_GE(small, 4) << logged;
+  for (std::size_t k = 0; k < want.trips.size(); ++k) {
+    EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), kRecordAgree) << "T" << k + 1;
+  }
+  ASSERT_TRUE(got.estimate.has_value());
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), kRecordAgree) << "S" << k + 1;
+  }
 }
 
 TEST(LinuxCncRuntime, HarnessAgreesWithCppOnRandomScansChecksAndPoints) {

@@ -20,8 +20,8 @@ done
 # another cell's name).
 base=$(mktemp)
 "$smtcal" simulate tests/linuxcnc-sim/monitor.place --cell $cell --cycles 6 --seed 30 --record "$base" -q > /dev/null
-sed 's/^smtcal-record 1 cell=paper-cell /smtcal-record 1 cell=other-cell /' "$base" > $out/warn_monitor_other_cell.log
-awk '$1 == "trip" && $3 == 3 && $4 == 3 { $6 = sprintf("%.6f", $6 + 0.01) } { print }' "$base" \
+sed 's/^smtcal-record 2 cell=paper-cell /smtcal-record 2 cell=other-cell /' "$base" > $out/warn_monitor_other_cell.log
+awk '$1 == "trip" && $3 == 3 && $4 == 3 { $6 = sprintf("%.9f", $6 + 0.01) } { print }' "$base" \
   > $out/warn_monitor_record_disagrees.log
 head -c -1 "$base" > $out/warn_record_cut_off.log
 awk '!($1 == "trip" && $3 == 6 && $4 >= 5) { print }' "$base" > $out/warn_record_incomplete.log
