@@ -139,8 +139,8 @@ struct FixtureMonitor {
   bool in_control = true;
 };
 
-// Recorded poses agree with the cell's recomputation to this (the LinuxCNC
-// runtime writes 6 decimals).
+// Recorded poses agree with the cell's recomputation to this (far above the
+// record's resolution, 1e-9 mm or finer: docs/monitor.md).
 inline constexpr double kRecordAgreementMm = 1e-4;
 
 struct MonitorResult {
