@@ -14,7 +14,13 @@
 # when the program releases it (On 14), the next board comes. After the last
 # planned cycle the driver stops the program, as an operator would.
 #
-# Recorded from linuxcnc.stat, polled every millisecond:
+# Recorded from linuxcnc.stat, polled every millisecond at a realtime
+# priority (SCHED_FIFO, below LinuxCNC's servo thread) where the host allows
+# it: the task writes the status every millisecond (CYCLE_TIME) and a probe
+# move's result shows there for as little as 15 ms (the two-stage scan's
+# moves back over an edge and latching it), its tripped flag for a few; at
+# a normal priority a poll on a loaded host (a parallel CTest) can come too
+# late for both. Each cycle records the longest gap between two polls:
 #   probes   every probe move's result: motion's latched position
 #            (probed_position, the #5061.. the runtime reads) and whether it
 #            tripped; a new result is a change of the position;
@@ -24,6 +30,8 @@
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
 #   messages every operator message (an abort is one);
+#   poll_gap_max_s per cycle, the longest time between two status polls
+#            (run_scenario.py names it when the probe moves do not add up);
 #   trace    per cycle, the machine's position (x, y, z) at every status
 #            update that shows it changed, from the clamp to the cycle's
 #            first vacuum change: when the scan's first move began and
@@ -44,6 +52,7 @@ import linuxcnc
 
 VACUUM_OUT = 8      # layers.place: Vacuum 8 -> motion.digital-out-08
 RELEASE_OUT = 14    # layers.place: On 14 releases the board (transport)
+POLL_PRIORITY = 20  # SCHED_FIFO; uspace's rtapi_app runs its threads near the top (98, 99)
 
 
 def hal(commands):
@@ -98,6 +107,13 @@ def main():
             json.dump(record, f, indent=1)
         os.replace(out_path + ".tmp", out_path)
 
+    try:
+        # Children (halcmd) run at the normal priority.
+        os.sched_setscheduler(0, os.SCHED_FIFO | os.SCHED_RESET_ON_FORK, os.sched_param(POLL_PRIORITY))
+        record["poll_priority"] = f"SCHED_FIFO {POLL_PRIORITY}"
+    except OSError as error:
+        record["poll_priority"] = f"normal (SCHED_FIFO refused: {error.strerror})"
+
     stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
     reader = None
     if real_pins:
@@ -145,8 +161,13 @@ def main():
     running_seen = False
     deadline = time.monotonic() + plan["timeout_s"]
     end = None
+    last_poll = time.monotonic()
     while end is None:
-        if time.monotonic() > deadline:
+        polled = time.monotonic()
+        if cycle is not None:
+            cycle["poll_gap_max_s"] = round(max(cycle["poll_gap_max_s"], polled - last_poll), 4)
+        last_poll = polled
+        if polled > deadline:
             end = "timeout: the run took longer than %s s" % plan["timeout_s"]
             command.abort()
             break
@@ -198,9 +219,10 @@ def main():
             hal(["sets transport-clamped true"])
             clamped = True
             stat.poll()
-            cycle = {"pose": pose, "clamped_s": now(), "probes": [],
+            cycle = {"pose": pose, "clamped_s": now(), "probes": [], "poll_gap_max_s": 0.0,
                      "trace": [[now()] + [round(v, 6) for v in stat.position[:3]]]}
             record["cycles"].append(cycle)
+            last_poll = time.monotonic()  # the board's placing is not a gap in the polls
             next_cycle += 1
         time.sleep(0.001)
     # Let the last status and messages arrive.

@@ -383,7 +383,7 @@ def scan_path_points(cell_text, fixture="Board"):
                            for x, y in path["points_mm"]] for path in board["scan_path"]}
 
 
-def trips_of_cycle(probes, paths, two_stage, path_points):
+def trips_of_cycle(probes, paths, two_stage, path_points, observer=""):
     """The trips the runtime latched, by index: its probe moves in order, per
     path until the first move that did not trip (smtcal_probe_trips.ngc).
     With two stages a trip is three probe moves (find the edge, back over
@@ -394,7 +394,8 @@ def trips_of_cycle(probes, paths, two_stage, path_points):
     can come after the next move began and the flag fell back. The runtime
     leaves a path at its first move that does not trip, so a move followed
     by another probe move on the same path (the nearest path's points: the
-    markers are far apart) tripped whatever the flag read."""
+    markers are far apart) tripped whatever the flag read. `observer`: how
+    the driver polled (its priority, its longest gap), for a failure."""
     def path_of(probe):
         return min(path_points, key=lambda name: min(math.dist((probe["x"], probe["y"]), point)
                                                      for point in path_points[name]))
@@ -413,7 +414,7 @@ def trips_of_cycle(probes, paths, two_stage, path_points):
             trips[index + k] = moves[-1]
         index += count
     if at != len(probes):
-        fail(f"{len(probes)} probe moves, but the scan paths explain only {at}")
+        fail(f"{len(probes)} probe moves, but the scan paths explain only {at}{observer}")
     return trips
 
 
@@ -592,7 +593,10 @@ def run_machine(args, scenario, work):
     verdicts = []
     check_cycles = []
     for n, cycle in enumerate(record["cycles"]):
-        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points)
+        observer = (f" (the driver polled at {record.get('poll_priority', '?')} priority, its longest gap between "
+                    f"two polls in this cycle {cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms: a probe "
+                    f"result can show for as little as 15 ms)")
+        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points, observer)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
         scan_json = os.path.join(work, f"cycle{n + 1}-scan.json")
@@ -611,7 +615,8 @@ def run_machine(args, scenario, work):
         if verdict["ok"]:
             error = pose_error(verdict, cycle["pose"])
             log(f"  cycle {n + 1}: scan overhead {overhead if overhead is None else round(overhead, 3)} s, "
-                f"board pose error {error:.4f} mm")
+                f"board pose error {error:.4f} mm, driver's longest poll gap "
+                f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms")
             measured.append({"overhead_s": overhead, "pose_error_mm": error})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
