@@ -557,9 +557,10 @@ class Decompiler {
     Expect("o<smtcal_data> call");
     // The check that the runtime on the path is the one compiled with the
     // program: two ifs, each aborting (not part of the program's text).
-    for (const char* condition : {"EXISTS[#<_smtcal_runtime_id>] EQ 0]", "#<_smtcal_runtime_id> NE "}) {
+    const std::string id(L::kRuntimeIdParameter);
+    for (const std::string& condition : {" if [EXISTS[" + id + "] EQ 0]", " if [" + id + " NE "}) {
       const NgcLine& check = Next();
-      if (!check.block.starts_with('o') || check.block.find(std::string(" if [") + condition) == std::string::npos) {
+      if (!check.block.starts_with('o') || check.block.find(condition) == std::string::npos) {
         Fail(check, "the main program without its runtime check");
       }
       if (!Next().comment.starts_with("abort,")) Fail(lines_[at_ - 1], "a runtime check without its abort");

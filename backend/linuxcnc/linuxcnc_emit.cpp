@@ -390,10 +390,10 @@ class Emitter {
         "the runtime on SUBROUTINE_PATH is not the one this program was compiled with [another cell or its "
         "tables; or another smtcal]: compile it again with --ini";
     const int known = NextOWord(), same = NextOWord();
-    Line(fmt::format("o{} if [EXISTS[#<_smtcal_runtime_id>] EQ 0]", known), loc);
+    Line(fmt::format("o{} if [EXISTS[{}] EQ 0]", known, linuxcnc_layout::kRuntimeIdParameter), loc);
     Abort(message, loc);
     Line(fmt::format("o{} endif", known), loc);
-    Line(fmt::format("o{} if [#<_smtcal_runtime_id> NE {}]", same, id), loc);
+    Line(fmt::format("o{} if [{} NE {}]", same, linuxcnc_layout::kRuntimeIdParameter, id), loc);
     Abort(message, loc);
     Line(fmt::format("o{} endif", same), loc);
   }

@@ -14,7 +14,16 @@
 # when the program releases it (On 14), the next board comes. After the last
 # planned cycle the driver stops the program, as an operator would.
 #
-# Recorded from linuxcnc.stat, polled every millisecond:
+# Recorded from linuxcnc.stat, polled every millisecond (the task writes
+# the status every millisecond, CYCLE_TIME; a probe move's result shows
+# there for as little as 15 ms, the two-stage scan's moves back over an
+# edge and latching it, its tripped flag for a few). Not at a realtime
+# priority: without a realtime kernel LinuxCNC's servo thread runs at the
+# normal one, and a driver that preempts it widens the window of LinuxCNC
+# 2.9's "Queue is not empty after probing" race (the first run here with a
+# SCHED_FIFO driver hit it); run_scenario.py runs the whole machine, driver
+# included, at nice -10 instead, ahead of a parallel CTest's load.
+# Each cycle records the longest gap between two polls:
 #   probes   every probe move's result: motion's latched position
 #            (probed_position, the #5061.. the runtime reads) and whether it
 #            tripped; a new result is a change of the position;
@@ -24,6 +33,8 @@
 #            machine stands; on a loaded host the update can come as the
 #            next move, the rise in z, begins);
 #   messages every operator message (an abort is one);
+#   poll_gap_max_s per cycle, the longest time between two status polls
+#            (run_scenario.py names it when the probe moves do not add up);
 #   trace    per cycle, the machine's position (x, y, z) at every status
 #            update that shows it changed, from the clamp to the cycle's
 #            first vacuum change: when the scan's first move began and
@@ -150,8 +161,13 @@ def main():
     running_seen = False
     deadline = time.monotonic() + plan["timeout_s"]
     end = None
+    last_poll = time.monotonic()
     while end is None:
-        if time.monotonic() > deadline:
+        polled = time.monotonic()
+        if cycle is not None:
+            cycle["poll_gap_max_s"] = round(max(cycle["poll_gap_max_s"], polled - last_poll), 4)
+        last_poll = polled
+        if polled > deadline:
             end = "timeout: the run took longer than %s s" % plan["timeout_s"]
             command.abort()
             break
@@ -203,9 +219,10 @@ def main():
             hal(["sets transport-clamped true"])
             clamped = True
             stat.poll()
-            cycle = {"pose": pose, "clamped_s": now(), "probes": [],
+            cycle = {"pose": pose, "clamped_s": now(), "probes": [], "poll_gap_max_s": 0.0,
                      "trace": [[now()] + [round(v, 6) for v in stat.position[:3]]]}
             record["cycles"].append(cycle)
+            last_poll = time.monotonic()  # the board's placing is not a gap in the polls
             next_cycle += 1
         time.sleep(0.001)
     # Let the last status and messages arrive.

@@ -260,6 +260,9 @@ def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("mar
     return ini
 
 
+MACHINE_NICE = -10
+
+
 def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None, modules=None):
     tmp = os.path.join(work, "tmp")
     os.makedirs(tmp, exist_ok=True)
@@ -276,7 +279,11 @@ def start_linuxcnc(work, ini, plan_path, run_path, timeout_s, extra_env=None, mo
     inner = 'mount --bind "$0" /tmp && cd "$1" && exec linuxcnc -r "$2"'
     if modules:
         inner = 'mount --bind "$3" /usr/lib/linuxcnc/modules && ' + inner
-    argv = ["timeout", "-k", "10", str(timeout_s + 60), "unshare", "--pid", "--fork", "--kill-child",
+    # At nice -10 (root): the servo thread runs at the normal priority without
+    # a realtime kernel, and the machine's processes, the driver with them,
+    # go ahead of a parallel CTest's load together.
+    argv = ["timeout", "-k", "10", str(timeout_s + 60), "nice", "-n", str(MACHINE_NICE),
+            "unshare", "--pid", "--fork", "--kill-child",
             "--mount-proc", "--ipc", "--mount", "sh", "-c", inner, tmp, work, ini, modules or ""]
     with open(os.path.join(work, "linuxcnc.log"), "w") as log_file:
         return subprocess.run(argv, env=env, stdout=log_file, stderr=subprocess.STDOUT).returncode
@@ -337,6 +344,33 @@ def run_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs):
             skip("LinuxCNC could not start here:\n" + tail)
         fail(f"LinuxCNC ended (exit {code}) without the driver's record; its log:\n{tail}")
     return json.load(open(run_path)), machine_s
+
+
+# LinuxCNC 2.9's own race (its issue 3650, the fix not released): after a
+# probe move the task can read motion's status from before the move was
+# queued, let the interpreter read on, and abort the program with this
+# error. Without a realtime kernel, where the servo thread can be preempted
+# mid-cycle, it comes about once in some thousands of probe moves here (the
+# example's scan makes 24 a cycle); it aborts the program before the cycle
+# places anything. A run it aborts says nothing about smtcal's program:
+# the scenario runs the machine again, at most twice, and says so.
+LINUXCNC_PROBE_RACE = "Queue is not empty after probing"
+LINUXCNC_PROBE_RACE_RUNS = 3
+
+
+def run_linuxcnc_past_its_probe_race(work, ini, plan_path, run_path, timeout_s):
+    """run_linuxcnc, run again when LinuxCNC's own probe race aborted it."""
+    for run_number in range(1, LINUXCNC_PROBE_RACE_RUNS + 1):
+        record, machine_s = run_linuxcnc(work, ini, plan_path, run_path, timeout_s)
+        raced = [m for m in record["messages"] if m["text"].strip() == LINUXCNC_PROBE_RACE]
+        if not raced:
+            return record, machine_s
+        cycle = raced[0]["cycle"] + 1
+        if run_number == LINUXCNC_PROBE_RACE_RUNS:
+            fail(f"LinuxCNC's own race ('{LINUXCNC_PROBE_RACE}', LinuxCNC issue 3650) aborted all "
+                 f"{run_number} runs (the last in cycle {cycle}); a race that often is not LinuxCNC's known one")
+        log(f"  LinuxCNC's own race ('{LINUXCNC_PROBE_RACE}', LinuxCNC issue 3650) aborted run {run_number} in "
+            f"cycle {cycle} after {machine_s:.1f} s: running the machine again")
 
 
 def work_root(path):
@@ -433,7 +467,7 @@ def scan_path_points(cell_text, fixture="Board"):
                            for x, y in path["points_mm"]] for path in board["scan_path"]}
 
 
-def trips_of_cycle(probes, paths, two_stage, path_points):
+def trips_of_cycle(probes, paths, two_stage, path_points, observer=""):
     """The trips the runtime latched, by index: its probe moves in order, per
     path until the first move that did not trip (smtcal_probe_trips.ngc).
     With two stages a trip is three probe moves (find the edge, back over
@@ -444,7 +478,8 @@ def trips_of_cycle(probes, paths, two_stage, path_points):
     can come after the next move began and the flag fell back. The runtime
     leaves a path at its first move that does not trip, so a move followed
     by another probe move on the same path (the nearest path's points: the
-    markers are far apart) tripped whatever the flag read."""
+    markers are far apart) tripped whatever the flag read. `observer`: how
+    the driver polled (its priority, its longest gap), for a failure."""
     def path_of(probe):
         return min(path_points, key=lambda name: min(math.dist((probe["x"], probe["y"]), point)
                                                      for point in path_points[name]))
@@ -463,7 +498,7 @@ def trips_of_cycle(probes, paths, two_stage, path_points):
             trips[index + k] = moves[-1]
         index += count
     if at != len(probes):
-        fail(f"{len(probes)} probe moves, but the scan paths explain only {at}")
+        fail(f"{len(probes)} probe moves, but the scan paths explain only {at}{observer}")
     return trips
 
 
@@ -625,7 +660,7 @@ def run_machine(args, scenario, work):
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
-    record, machine_s = run_linuxcnc(work, ini, plan_path, run_path, plan["timeout_s"])
+    record, machine_s = run_linuxcnc_past_its_probe_race(work, ini, plan_path, run_path, plan["timeout_s"])
     log(f"  {os.path.basename(scenario['program'])}, {len(record['cycles'])} cycle(s), "
         f"LinuxCNC ran {machine_s:.1f} s (ready after {record['times'].get('ready_s', 0):.1f} s), "
         f"run ended: {record['end']}")
@@ -651,7 +686,10 @@ def run_machine(args, scenario, work):
     check_cycles = []
     latched = []
     for n, cycle in enumerate(record["cycles"]):
-        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points)
+        observer = (f" (the driver's longest gap between two status polls in this cycle "
+                    f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms: a probe result can show for as "
+                    f"little as 15 ms)")
+        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points, observer)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
         scan_json = os.path.join(work, f"cycle{n + 1}-scan.json")
@@ -670,7 +708,8 @@ def run_machine(args, scenario, work):
         if verdict["ok"]:
             error = pose_error(verdict, cycle["pose"])
             log(f"  cycle {n + 1}: scan overhead {overhead if overhead is None else round(overhead, 3)} s, "
-                f"board pose error {error:.4f} mm")
+                f"board pose error {error:.4f} mm, driver's longest poll gap "
+                f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms")
             measured.append({"overhead_s": overhead, "pose_error_mm": error})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
