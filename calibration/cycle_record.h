@@ -52,7 +52,6 @@ struct RecordFixture {
 struct RecordBegin {
   int version = kRecordFormat;
   std::string cell;
-  std::string program;
   std::vector<RecordFixture> fixtures;
   std::string clock;  // "none" without a clock
   long segment = 0;   // the writer's count of log files

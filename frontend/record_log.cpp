@@ -181,13 +181,13 @@ class Reader {
 
   // --- lines ---------------------------------------------------------------------
 
-  // smtcal-record VERSION cell=NAME program=NAME fixtures=NAME:TRIPS,... clock=NAME segment=N
+  // smtcal-record VERSION cell=NAME fixtures=NAME:TRIPS,... clock=NAME segment=N
   bool Begin(const std::vector<Token>& tokens) {
     LoggedBegin logged;
     logged.where = At(tokens.front());
     if (tokens.size() < 2) {
       diags_.Report(DiagKind::RecordFieldCount, At(tokens.front()), kBeginTag, "no version",
-                    "its format version and the keys cell, program, fixtures, clock and segment");
+                    "its format version and the keys cell, fixtures, clock and segment");
       return false;
     }
     const std::optional<long> version = Whole(tokens[1], "the format version", 1, 1'000'000);
@@ -205,7 +205,7 @@ class Reader {
     }
     RecordBegin& begin = logged.begin;
     begin.version = static_cast<int>(*version);
-    const std::vector<std::string> keys = {"cell", "program", "fixtures", "clock", "segment"};
+    const std::vector<std::string> keys = {"cell", "fixtures", "clock", "segment"};
     std::map<std::string, Token> given;
     bool ok = true;
     for (std::size_t i = 2; i < tokens.size(); ++i) {
@@ -216,8 +216,8 @@ class Reader {
       if (equals == std::string_view::npos || !known) {
         const std::string closest = ClosestName(key, keys);
         diags_.Report(DiagKind::RecordBadBeginKey, At(tokens[i]),
-                      fmt::format("'{}' is not a key of the begin line{}: its keys are cell=, program=, fixtures=, "
-                                  "clock= and segment=",
+                      fmt::format("'{}' is not a key of the begin line{}: its keys are cell=, fixtures=, clock= "
+                                  "and segment=",
                                   Printable(text), closest.empty() ? "" : fmt::format(" (did you mean '{}='?)", closest)));
         ok = false;
         continue;
@@ -248,7 +248,7 @@ class Reader {
       }
       return std::string(value.text);
     };
-    const std::optional<std::string> cell = name("cell"), program = name("program"), clock = name("clock");
+    const std::optional<std::string> cell = name("cell"), clock = name("clock");
     const std::optional<long> segment = Whole(given.at("segment"), "the segment", 0, 1'000'000'000);
     bool fixtures_ok = true;
     const Token& fixtures = given.at("fixtures");
@@ -276,9 +276,8 @@ class Reader {
         start = comma + 1;
       }
     }
-    if (!cell || !program || !clock || !segment || !fixtures_ok) return false;
+    if (!cell || !clock || !segment || !fixtures_ok) return false;
     begin.cell = *cell;
-    begin.program = *program;
     begin.clock = *clock;
     begin.segment = *segment;
     if (!log_.begins.empty() && begin.segment < log_.begins.back().begin.segment) {

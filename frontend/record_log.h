@@ -4,7 +4,7 @@
 // double nearest its text) and strictly: every mistake is a diagnostic at
 // its line and field.
 //
-//   smtcal-record 2 cell=paper-cell program=PaperCell fixtures=Board:8 clock=none segment=0
+//   smtcal-record 2 cell=paper-cell fixtures=Board:8 clock=none segment=0
 //   cycle 0 1 0 0 - 138.3 39.8 328.3 39.98 138.29 129.8
 //   checks 0 1 0 0.523 0 0 0 0 52.9e-6 0.36 0.1 - -
 //   trip 0 1 1 138317400.000000000e-6 42.8

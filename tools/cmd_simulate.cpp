@@ -47,14 +47,12 @@ struct SimulateOptions {
 constexpr int kRecordDecimals = 9;
 
 // The improved mode's scans as the controller would log them (docs/monitor.md).
-Status WriteRecord(const std::string& path, const SimResult& result, const cell::Cell& cell,
-                   const std::string& program) {
+Status WriteRecord(const std::string& path, const SimResult& result, const cell::Cell& cell) {
   Result<std::unique_ptr<TextOutput>> opened = TextOutput::Open(path);
   if (!opened) return opened.error();
   TextOutput& out = *opened.value();
   RecordBegin begin;
   begin.cell = cell.name;
-  begin.program = program;
   for (const cell::Fixture& fixture : cell.fixtures) begin.fixtures.push_back({fixture.name, ExpectedTrips(fixture).size()});
   begin.clock = "simulate";
   out.Append(RecordBeginText(begin));
@@ -179,7 +177,7 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
     }
   }
   if (!opt.record.empty()) {
-    if (Status written = WriteRecord(opt.record, result, *compiled.cell, ir::ProgramName(compiled.program)); !written) {
+    if (Status written = WriteRecord(opt.record, result, *compiled.cell); !written) {
       options.exit_code = ReportIoError(written.error());
       return;
     }

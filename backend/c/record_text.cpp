@@ -28,7 +28,7 @@ std::string RecordBeginText(const RecordBegin& begin) {
     fixtures[k].name = begin.fixtures[k].name.c_str();
     fixtures[k].trip_count = static_cast<int>(begin.fixtures[k].trips);
   }
-  const smtcal_program program{begin.program.c_str(), nullptr, 0, fixtures.empty() ? nullptr : fixtures.data(),
+  const smtcal_program program{nullptr, nullptr, 0, fixtures.empty() ? nullptr : fixtures.data(),
                                static_cast<int>(fixtures.size()), nullptr, 0};
   return Formatted([&](char* buffer, std::size_t size) {
     return smtcal_record_begin(&program, begin.cell.c_str(), begin.clock == "none" ? nullptr : begin.clock.c_str(),

@@ -15,6 +15,7 @@
 
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/embedded_files.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/check.h"
 #include "calibration/fixture_geometry.h"
@@ -282,6 +283,8 @@ long LinuxCncRuntimeId(const cell::Cell& cell) {
   for (const EmbeddedFile& file : LinuxCncRuntimeFiles()) hash = Fnv1a(Fnv1a(hash, file.name), file.text);
   hash = Fnv1a(hash, DataText(cell, std::nullopt));
   hash = Fnv1a(hash, EmitLinuxCncScanAbort(cell));
+  hash = Fnv1a(hash, EmitLinuxCncRecord(cell));
+  hash = Fnv1a(hash, EmitLinuxCncRecordOpen(cell));
   return static_cast<long>(hash & 0x7fffffffu);
 }
 

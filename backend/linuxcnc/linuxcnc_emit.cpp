@@ -1094,9 +1094,8 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
                                            const std::string& program_path, TextOutput& main, Diagnostics& diags) {
   SMTCAL_CHECK(state.cell != nullptr, "the linuxcnc target needs a compiled program");
   const cell::Cell& cell = *state.cell;
-  const std::string name = ir::ProgramName(program);
   std::optional<std::string> problem = LinuxCncDataProblem(cell);
-  if (!problem) problem = LinuxCncRecordProblem(cell, name);
+  if (!problem) problem = LinuxCncRecordProblem(cell);
   if (problem) {
     // At the fixture whose scan is too long when one is, else at the cell.
     SourceRange where(SourceLoc{cell.file, 1, 1});
@@ -1122,8 +1121,8 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
   output.subroutines.push_back({"smtcal_scan_abort.ngc", EmitLinuxCncScanAbort(cell)});
-  output.subroutines.push_back({"smtcal_record.ngc", EmitLinuxCncRecord(cell, name)});
-  output.subroutines.push_back({"smtcal_record_open.ngc", EmitLinuxCncRecordOpen(cell, name)});
+  output.subroutines.push_back({"smtcal_record.ngc", EmitLinuxCncRecord(cell)});
+  output.subroutines.push_back({"smtcal_record_open.ngc", EmitLinuxCncRecordOpen(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
             [](const EmbeddedFile& a, const EmbeddedFile& b) { return a.name < b.name; });
   return output;

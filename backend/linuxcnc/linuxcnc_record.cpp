@@ -19,15 +19,15 @@ namespace L = linuxcnc_layout;
 constexpr std::size_t kMaxLineChars = 253;
 
 // The begin line as a LOG comment: the format, the names, the segment.
-std::string BeginComment(const cell::Cell& cell, std::string_view program) {
+std::string BeginComment(const cell::Cell& cell) {
   std::string fixtures;
   for (const cell::Fixture& fixture : cell.fixtures) {
     fixtures += fmt::format("{}{}:{}", fixtures.empty() ? "" : ",", RecordName(fixture.name),
                             ExpectedTrips(fixture).size());
   }
   const cell::LinuxCnc& linuxcnc = *cell.linuxcnc;
-  return fmt::format("(LOG,smtcal-record {} cell={} program={} fixtures={} clock={} segment=%d#{})", kRecordFormat,
-                     RecordName(cell.name), RecordName(program), fixtures.empty() ? "-" : fixtures,
+  return fmt::format("(LOG,smtcal-record {} cell={} fixtures={} clock={} segment=%d#{})", kRecordFormat,
+                     RecordName(cell.name), fixtures.empty() ? "-" : fixtures,
                      linuxcnc.record_clock_pin.empty() ? "none" : linuxcnc.record_clock_pin, L::kRecordSegment);
 }
 
@@ -58,13 +58,13 @@ std::string Scaled(int parameter) { return fmt::format("#{}e-6", parameter); }
 
 std::string LinuxCncRecordSecondFile(std::string_view record_file) { return std::string(record_file) + ".1"; }
 
-std::optional<std::string> LinuxCncRecordProblem(const cell::Cell& cell, std::string_view program) {
+std::optional<std::string> LinuxCncRecordProblem(const cell::Cell& cell) {
   if (!Records(cell)) return std::nullopt;
-  const std::string begin = BeginComment(cell, program);
+  const std::string begin = BeginComment(cell);
   if (begin.size() > kMaxLineChars) {
     return fmt::format(
         "the cycle record's begin line, {}, is {} characters long, and LinuxCNC reads lines of at most {}: shorten "
-        "the names of the cell, the program or the fixtures",
+        "the names of the cell or of its fixtures",
         begin, begin.size(), kMaxLineChars);
   }
   const std::string open = fmt::format("  (LOGOPEN,{})", LinuxCncRecordSecondFile(cell.linuxcnc->record_file));
@@ -75,7 +75,7 @@ std::optional<std::string> LinuxCncRecordProblem(const cell::Cell& cell, std::st
   return std::nullopt;
 }
 
-std::string EmitLinuxCncRecordOpen(const cell::Cell& cell, std::string_view program) {
+std::string EmitLinuxCncRecordOpen(const cell::Cell& cell) {
   std::string out = Header(
       "smtcal_record_open.ngc", cell,
       "; o<smtcal_record_open> call: at the start of the program (smtcal_data calls it) opens the log of\n"
@@ -113,12 +113,12 @@ std::string EmitLinuxCncRecordOpen(const cell::Cell& cell, std::string_view prog
   out += "o<smtcal_ro_file> else\n";
   out += fmt::format("  (LOGAPPEND,{})\n", LinuxCncRecordSecondFile(linuxcnc.record_file));
   out += "o<smtcal_ro_file> endif\n";
-  out += BeginComment(cell, program) + "\n";
+  out += BeginComment(cell) + "\n";
   out += "o<smtcal_record_open> endsub\n";
   return out;
 }
 
-std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program) {
+std::string EmitLinuxCncRecord(const cell::Cell& cell) {
   std::string out = Header(
       "smtcal_record.ngc", cell,
       "; o<smtcal_record> call [k]: appends the record of fixture k's last scan to the log (a cycle\n"
@@ -144,7 +144,7 @@ std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program)
   out += "  o<smtcal_rec_next> else\n";
   out += fmt::format("    (LOGOPEN,{})\n", LinuxCncRecordSecondFile(linuxcnc.record_file));
   out += "  o<smtcal_rec_next> endif\n";
-  out += "  " + BeginComment(cell, program) + "\n";
+  out += "  " + BeginComment(cell) + "\n";
   out += "o<smtcal_rec_full> endif\n";
   out += fmt::format("#{0} = [#{0} + 1]\n", L::kRecordCount);
   // The buffer: fixture, cycle, status, trip, time, S1..S3, the checks; the

@@ -30,14 +30,16 @@
 namespace smtcal {
 
 // The text of smtcal_record.ngc and of smtcal_record_open.ngc for the cell
-// and the program's name (deterministic). Without [linuxcnc] record_file
-// both are subroutines that do nothing.
-std::string EmitLinuxCncRecord(const cell::Cell& cell, std::string_view program);
-std::string EmitLinuxCncRecordOpen(const cell::Cell& cell, std::string_view program);
+// (deterministic). They hold nothing of a program: they are part of the
+// runtime that every program of the cell shares (LinuxCncRuntimeId hashes
+// them). Without [linuxcnc] record_file both are subroutines that do
+// nothing.
+std::string EmitLinuxCncRecord(const cell::Cell& cell);
+std::string EmitLinuxCncRecordOpen(const cell::Cell& cell);
 
 // Why the cell's record cannot be written by LinuxCNC (its begin line would
 // be longer than a G-code line may be), or nullopt.
-std::optional<std::string> LinuxCncRecordProblem(const cell::Cell& cell, std::string_view program);
+std::optional<std::string> LinuxCncRecordProblem(const cell::Cell& cell);
 
 // The second file of the log.
 std::string LinuxCncRecordSecondFile(std::string_view record_file);

@@ -176,8 +176,6 @@ int smtcal_record_begin(const smtcal_program *program, const char *cell_name, co
   if (size > 0) buffer[0] = '\0';
   put(&out, "smtcal-record %d cell=", SMTCAL_RECORD_FORMAT);
   put_name(&out, cell_name);
-  put(&out, " program=");
-  put_name(&out, program->name);
   put(&out, " fixtures=");
   for (k = 0; k < program->fixture_count; ++k) {
     if (k > 0) put(&out, ",");

@@ -77,7 +77,7 @@ smtcal_scan_status smtcal_record_scan(const smtcal_fixture *fixture, int fixture
 int smtcal_record_format(const smtcal_record *record, int decimals, char *buffer, size_t size);
 
 /* The begin line that opens a log (or a part of one): the format version,
- * the cell's and the program's names, every fixture with its trip count,
+ * the cell's name, every fixture of the program with its trip count,
  * the clock (NULL or "": none) and the log's segment number (the caller's
  * count of log files, 0 when it keeps one). Names are written with letters,
  * digits and `_ - .`, anything else as `_`. Returns and writes like

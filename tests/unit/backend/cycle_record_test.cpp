@@ -117,7 +117,6 @@ TEST(CycleRecord, ReadsBackExactlyWhatTheCRuntimeWrites) {
 
     RecordBegin begin;
     begin.cell = c.cell.name;
-    begin.program = "Layer A";
     begin.fixtures = {{fixture.name, 8}};
     begin.clock = time ? "smtcal-clock.out" : "none";
     begin.segment = i;
@@ -129,7 +128,6 @@ TEST(CycleRecord, ReadsBackExactlyWhatTheCRuntimeWrites) {
     ASSERT_EQ(diags.warning_count(), 0u) << diags.RenderText();
     ASSERT_EQ(log.begins.size(), 1u);
     EXPECT_EQ(log.begins[0].begin.cell, "paper_cell");
-    EXPECT_EQ(log.begins[0].begin.program, "Layer_A");
     EXPECT_EQ(log.begins[0].begin.clock, begin.clock);
     EXPECT_EQ(log.begins[0].begin.segment, i);
     ASSERT_EQ(log.cycles.size(), 1u) << text;
@@ -196,7 +194,6 @@ TEST(CycleRecord, SixDecimalsReadBackAsTheirDigits) {
   const CycleRecord want = RecordOfScan(0, 7, 1234.5, scan);
   RecordBegin begin;
   begin.cell = "paper-cell";
-  begin.program = "P";
   begin.fixtures = {{"Board", 8}};
   const std::string text = RecordBeginText(begin) + CycleRecordText(want, 6);
   SourceManager sources;

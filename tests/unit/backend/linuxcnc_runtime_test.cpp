@@ -81,8 +81,8 @@ struct Workspace {
     }
     std::ofstream(sub / "smtcal_data.ngc", std::ios::binary) << EmitLinuxCncData(cell);
     std::ofstream(sub / "smtcal_scan_abort.ngc", std::ios::binary) << EmitLinuxCncScanAbort(cell);
-    std::ofstream(sub / "smtcal_record.ngc", std::ios::binary) << EmitLinuxCncRecord(cell, "test");
-    std::ofstream(sub / "smtcal_record_open.ngc", std::ios::binary) << EmitLinuxCncRecordOpen(cell, "test");
+    std::ofstream(sub / "smtcal_record.ngc", std::ios::binary) << EmitLinuxCncRecord(cell);
+    std::ofstream(sub / "smtcal_record_open.ngc", std::ios::binary) << EmitLinuxCncRecordOpen(cell);
     std::vector<fs::path> path;
     if (with_override_dir) {
       fs::create_directories(dir / "first");
@@ -322,6 +322,23 @@ TEST(LinuxCncData, ExampleCellIsDeterministicAndSaysWhereItCameFrom) {
     EXPECT_EQ(number.find_first_not_of("-.0123456789"), std::string::npos) << line;
   }
   EXPECT_GT(assignments, 1000);
+}
+
+// Every program of a cell shares its runtime folder (compile --ini), the
+// record's subroutines with it: they hold nothing of a program, and the
+// runtime id the main program checks covers them.
+TEST(LinuxCncData, RecordSubroutinesArePartOfTheSharedRuntime) {
+  std::string diagnostics;
+  std::optional<cell::Cell> cell = LoadPaperCell(&diagnostics);
+  ASSERT_TRUE(cell) << diagnostics;
+  ASSERT_TRUE(cell->linuxcnc && !cell->linuxcnc->record_file.empty());
+  EXPECT_EQ(EmitLinuxCncRecordOpen(*cell).find("program="), std::string::npos);
+  EXPECT_EQ(EmitLinuxCncRecord(*cell).find("program="), std::string::npos);
+  const long id = LinuxCncRuntimeId(*cell);
+  cell->linuxcnc->record_file = "other-" + cell->linuxcnc->record_file;
+  EXPECT_NE(LinuxCncRuntimeId(*cell), id) << "the record's log file is not in the runtime id";
+  cell->linuxcnc->record_file.clear();
+  EXPECT_NE(LinuxCncRuntimeId(*cell), id) << "a runtime without a record has the id of one with it";
 }
 
 TEST(LinuxCncData, RefusesWhatDoesNotFitTheParameters) {

@@ -7,7 +7,7 @@
 namespace smtcal {
 namespace {
 
-constexpr const char* kBegin = "smtcal-record 2 cell=paper-cell program=P fixtures=Board:2 clock=none segment=0\n";
+constexpr const char* kBegin = "smtcal-record 2 cell=paper-cell fixtures=Board:2 clock=none segment=0\n";
 
 std::string Record(long cycle, const char* status_line = "0 0 - 138 40 328 40 138 130",
                    const char* checks = "0 0.1 0 0 0 0 0.01 0 0 - -") {
@@ -64,13 +64,13 @@ TEST(RecordLog, MistakesAreReportedAtTheirField) {
   };
   const std::vector<Case> cases = {
       {"cycle 0 1 0 0 - 1 2 3 4 5 6\n", "a.log:1:1: error: the first line of 'a.log' is 'cycle 0 1 0 0 - 1 2 3 4 5 6'"},
-      {"smtcal-record 3 cell=a program=b fixtures=F:8 clock=none segment=0\n", "a.log:1:15: error: format version 3"},
-      {"smtcal-record 1 cell=a program=b fixtures=F:8 clock=none segment=0\n",
+      {"smtcal-record 3 cell=a fixtures=F:8 clock=none segment=0\n", "a.log:1:15: error: format version 3"},
+      {"smtcal-record 1 cell=a fixtures=F:8 clock=none segment=0\n",
        "format version 1 is not one this smtcal reads (it reads version 2): in format 1 the LinuxCNC runtime wrote "
        "every value below 1e-4 mm or deg as 0"},
-      {"smtcal-record 2 cell=a progam=b fixtures=F:8 clock=none segment=0\n",
-       "'progam=b' is not a key of the begin line (did you mean 'program='?)"},
-      {"smtcal-record 2 cell=a program=b fixtures=F:40 clock=none segment=0\n", "a fixture's trip count is '40': outside 1..32"},
+      {"smtcal-record 2 cell=a fixtures=F:8 clok=none segment=0\n",
+       "'clok=none' is not a key of the begin line (did you mean 'clock='?)"},
+      {"smtcal-record 2 cell=a fixtures=F:40 clock=none segment=0\n", "a fixture's trip count is '40': outside 1..32"},
       {std::string(kBegin) + "cycle 0 1 0 0 - 138 40 328 40 138\n", "a 'cycle' line has 11 fields here: it needs 12 fields"},
       {std::string(kBegin) + "cycle 1 1 0 0 - 138 40 328 40 138 130\n", "the fixture is '1': outside 0..0"},
       {std::string(kBegin) + "cycle 0 1 0 0 - 138 40 328 40 138 1e999\n", "is '1e999': not a finite number"},
@@ -91,8 +91,8 @@ TEST(RecordLog, MistakesAreReportedAtTheirField) {
       {std::string(kBegin) + Record(1, "1 1 - - - - - - -", "1 0 - - - - - - - - -"),
        "check 2 has a value, but no check runs after missing_trip fails"},
       {std::string(kBegin) + Record(3) + Record(2), "cycle 2 of fixture 'Board' follows its cycle 3: the log goes back"},
-      {std::string(kBegin) + "smtcal-record 2 cell=a program=b fixtures=Board:2 clock=none segment=0\n" +
-           "smtcal-record 2 cell=a program=b fixtures=Board:2 clock=none segment=-1\n",
+      {std::string(kBegin) + "smtcal-record 2 cell=a fixtures=Board:2 clock=none segment=0\n" +
+           "smtcal-record 2 cell=a fixtures=Board:2 clock=none segment=-1\n",
        "the segment is '-1'"},
   };
   for (const Case& c : cases) {
@@ -108,7 +108,7 @@ TEST(RecordLog, MissingCyclesAreAWarningAndLogsContinueAcrossFiles) {
   RecordLog log;
   ASSERT_TRUE(ReadRecordLog(sources.Add("a.log", std::string(kBegin) + Record(1) + Record(2)), log, diags));
   ASSERT_TRUE(ReadRecordLog(
-      sources.Add("b.log", "smtcal-record 2 cell=paper-cell program=P fixtures=Board:2 clock=none segment=1\n" +
+      sources.Add("b.log", "smtcal-record 2 cell=paper-cell fixtures=Board:2 clock=none segment=1\n" +
                                Record(5)),
       log, diags));
   EXPECT_EQ(log.cycles.size(), 3u);
@@ -118,7 +118,7 @@ TEST(RecordLog, MissingCyclesAreAWarningAndLogsContinueAcrossFiles) {
       << diags.RenderText();
   // A third file older than the second: refused.
   EXPECT_FALSE(ReadRecordLog(
-      sources.Add("c.log", "smtcal-record 2 cell=paper-cell program=P fixtures=Board:2 clock=none segment=0\n"), log,
+      sources.Add("c.log", "smtcal-record 2 cell=paper-cell fixtures=Board:2 clock=none segment=0\n"), log,
       diags));
 }
 
