@@ -402,6 +402,8 @@ class FixtureAnalysis {
       chart.cusum_k = options_.cusum_k;
       chart.cusum_h = options_.cusum_h;
       chart.cusum_clip = options_.cusum_clip;
+      chart.ewma_lambda = options_.ewma_lambda;
+      chart.ewma_l = options_.ewma_l;
       chart.direction = kInfo[q].direction;
       chart.resolution = kInfo[q].resolution;
       series.chart = RunChart(series.values, chart);

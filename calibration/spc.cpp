@@ -193,6 +193,8 @@ std::string_view ChartRuleName(ChartRule rule) {
     case ChartRule::kMovingRange: return "moving-range";
     case ChartRule::kCusumUp: return "cusum-up";
     case ChartRule::kCusumDown: return "cusum-down";
+    case ChartRule::kEwmaUp: return "ewma-up";
+    case ChartRule::kEwmaDown: return "ewma-down";
   }
   return "?";
 }
@@ -207,6 +209,8 @@ std::string_view ChartRuleDescription(ChartRule rule) {
     case ChartRule::kMovingRange: return "a moving range beyond 3.267 times its mean";
     case ChartRule::kCusumUp: return "the CUSUM of upward shifts beyond its decision interval";
     case ChartRule::kCusumDown: return "the CUSUM of downward shifts beyond its decision interval";
+    case ChartRule::kEwmaUp: return "the EWMA above its upper control limit";
+    case ChartRule::kEwmaDown: return "the EWMA below its lower control limit";
   }
   return "?";
 }
@@ -231,9 +235,11 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
   chart.sigma_estimate = std::max({chart.mr_mean / kD2, std::sqrt(squares / (m - 1)), options.resolution});
   chart.sigma = chart.sigma_estimate;
   double k = options.cusum_k;
+  double centre_uncertainty = 0;
   if (options.guard_estimates) {
     chart.sigma *= std::sqrt((m - 1) / ChiSquareQuantile(0.05, m - 1));
-    k += NormalQuantile(0.95) / std::sqrt(m);  // the centre line is known to +-1.645 sigma / sqrt(n)
+    centre_uncertainty = NormalQuantile(0.95) / std::sqrt(m);  // the centre line is known to +-1.645 sigma / sqrt(n)
+    k += centre_uncertainty;
   }
   chart.cusum_k = k;
   const bool up = options.direction != Direction::kDown, down = options.direction != Direction::kUp;
@@ -255,8 +261,13 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
   double c_up = 0, c_down = 0;
   chart.cusum_up.resize(n);
   chart.cusum_down.resize(n);
+  chart.ewma.resize(n);
+  chart.ewma_limit.resize(n);
   std::size_t last_zero_up = 0, last_zero_down = 0;
   bool zero_up_seen = false, zero_down_seen = false;
+  const double lambda = options.ewma_lambda;
+  double ewma = 0, decay = 1;  // decay: (1 - lambda)^2i
+  std::optional<std::size_t> last_below, last_above;  // the EWMA's last value at or below / above the centre
   for (std::size_t i = 0; i < n; ++i) {
     auto set = [&](ChartRule rule) { holds[static_cast<std::size_t>(rule)][i] = true; };
     if ((up && z[i] > 3) || (down && z[i] < -3)) set(ChartRule::kNelson1);
@@ -295,10 +306,28 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     if (!chart.alarm && (c_up > options.cusum_h || c_down > options.cusum_h)) {
       chart.alarm = i;
       const bool upward = c_up > options.cusum_h;
+      chart.alarm_rule = upward ? ChartRule::kCusumUp : ChartRule::kCusumDown;
       chart.alarm_direction = upward ? Direction::kUp : Direction::kDown;
       const bool seen = upward ? zero_up_seen : zero_down_seen;
       chart.change_point = seen ? (upward ? last_zero_up : last_zero_down) + 1 : 0;
     }
+    ewma = lambda * clipped + (1 - lambda) * ewma;
+    decay *= (1 - lambda) * (1 - lambda);
+    const double limit = options.ewma_l * std::sqrt(lambda / (2 - lambda) * (1 - decay)) + centre_uncertainty;
+    chart.ewma[i] = ewma;
+    chart.ewma_limit[i] = limit;
+    const bool ewma_up = up && ewma > limit, ewma_down = down && ewma < -limit;
+    if (ewma_up) set(ChartRule::kEwmaUp);
+    if (ewma_down) set(ChartRule::kEwmaDown);
+    if (!chart.alarm && (ewma_up || ewma_down)) {
+      chart.alarm = i;
+      chart.alarm_rule = ewma_up ? ChartRule::kEwmaUp : ChartRule::kEwmaDown;
+      chart.alarm_direction = ewma_up ? Direction::kUp : Direction::kDown;
+      const std::optional<std::size_t>& other_side = ewma_up ? last_below : last_above;
+      chart.change_point = other_side ? *other_side + 1 : 0;
+    }
+    if (ewma <= 0) last_below = i;
+    if (ewma >= 0) last_above = i;
     if (c_up == 0) {
       last_zero_up = i;
       zero_up_seen = true;

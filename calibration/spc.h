@@ -1,12 +1,15 @@
 // Statistical process control for `smtcal monitor` (docs/monitor.md): the
 // quantiles the confidence intervals need, process figures with their
 // intervals, and control charts of individual values — the centre line and
-// sigma from a baseline, Nelson's rules, and a CUSUM for slow drifts.
+// sigma from a baseline, Nelson's rules, and a CUSUM and an EWMA for slow
+// drifts.
 //
 // Names follow the SPC literature: Montgomery, "Introduction to Statistical
 // Quality Control"; L. S. Nelson, "The Shewhart Control Chart — Tests for
 // Special Causes", J. Quality Technology 16 (1984); Bissell, "How Reliable is
-// Your Capability Index?", Applied Statistics 39 (1990).
+// Your Capability Index?", Applied Statistics 39 (1990); Lucas and
+// Saccucci, "Exponentially Weighted Moving Average Control Schemes",
+// Technometrics 32 (1990).
 #pragma once
 
 #include <cstddef>
@@ -55,9 +58,12 @@ ProcessFigures FiguresOf(const std::vector<double>& values, double confidence, L
 // row steadily increasing or decreasing; 5 two of three points in a row
 // beyond 2 sigma on the same side; 6 four of five beyond 1 sigma on the same
 // side. The moving range beyond D4 = 3.267 times its mean (the MR chart). A
-// tabular CUSUM crossing its decision interval, upwards or downwards.
-enum class ChartRule { kNelson1, kNelson2, kNelson3, kNelson5, kNelson6, kMovingRange, kCusumUp, kCusumDown };
-inline constexpr std::size_t kChartRules = 8;
+// tabular CUSUM crossing its decision interval, upwards or downwards. An
+// EWMA beyond its control limit, upwards or downwards.
+enum class ChartRule {
+  kNelson1, kNelson2, kNelson3, kNelson5, kNelson6, kMovingRange, kCusumUp, kCusumDown, kEwmaUp, kEwmaDown
+};
+inline constexpr std::size_t kChartRules = 10;
 std::string_view ChartRuleName(ChartRule rule);         // "nelson-1", ..., "cusum-up"
 std::string_view ChartRuleDescription(ChartRule rule);  // "a point beyond 3 sigma", ...
 
@@ -71,13 +77,22 @@ struct ChartOptions {
   double cusum_k = 0.5;
   double cusum_h = 10;
   double cusum_clip = 4;
+  // The EWMA of the standardized values (clipped as the CUSUM's), started at
+  // the centre line: E = lambda z + (1 - lambda) E. It alarms beyond
+  // ewma_l of its own standard deviations (the exact one of value i,
+  // sigma sqrt(lambda / (2 - lambda) (1 - (1 - lambda)^2i))), plus the
+  // centre's uncertainty when guarded. A small lambda averages long: it
+  // sees a slow drift (a ramp) sooner than the CUSUM, whose reference value
+  // k it must first outgrow.
+  double ewma_lambda = 0.05;
+  double ewma_l = 4.1;
   Direction direction = Direction::kBoth;
   double resolution = 0;  // sigma is at least this (the record's resolution)
   // A baseline of n values knows the centre and sigma only roughly, and a
   // sigma estimated low, or a centre off by a fraction of sigma, makes a
   // CUSUM alarm in long in-control runs. Guarded: sigma is its upper 95 %
-  // confidence bound and the reference value k grows by the centre's
-  // uncertainty, 1.645 / sqrt(n) sigmas.
+  // confidence bound, and the CUSUM's reference value k and the EWMA's limit
+  // grow by the centre's uncertainty, 1.645 / sqrt(n) sigmas.
   bool guard_estimates = true;
 };
 
@@ -96,11 +111,15 @@ struct ChartResult {
   double cusum_k = 0;         // the CUSUM's reference value in sigmas, guarded
   double mr_mean = 0;         // mean moving range of the baseline
   std::vector<double> cusum_up, cusum_down;  // in sigmas, per value
+  std::vector<double> ewma, ewma_limit;      // in sigmas from the centre line, per value
   std::vector<RuleRun> runs;  // every run of every rule, in order of their first point
-  // The first CUSUM alarm: where it crossed h, the direction, and where the
-  // shift it signals most likely began (the last value before it at which
-  // that CUSUM was zero).
+  // The first alarm of the CUSUM or the EWMA: where it crossed its limit,
+  // the rule, the direction, and where the shift it signals most likely
+  // began (the CUSUM's: the last value before it at which that CUSUM was
+  // zero; the EWMA's: the last value before it at which the EWMA was on the
+  // centre line's other side).
   std::optional<std::size_t> alarm;
+  ChartRule alarm_rule = ChartRule::kCusumUp;
   Direction alarm_direction = Direction::kBoth;
   std::size_t change_point = 0;
 };

@@ -175,7 +175,7 @@ void AddMonitorCommand(CLI::App& app, GlobalOptions& options) {
                     "report only: exit 0 even when the cell is out of control (input and I/O errors still exit 1 "
                     "and 3)");
   monitor->footer(
-      "Exit codes: 0 in control, 1 out of control (a CUSUM alarm on a chart, or refusals rising) or errors in "
+      "Exit codes: 0 in control, 1 out of control (a CUSUM or EWMA alarm on a chart, or refusals rising) or errors in "
       "the input, 2 usage, 3 I/O. A shift-start script: smtcal monitor board.log --cell cell.toml -q || stop.");
   monitor->callback([&options] { RunMonitor(opt, options); });
 }

@@ -74,8 +74,14 @@ std::vector<std::string> Explain(const Finding& finding, const FixtureMonitor& f
     if (*finding.scans_to_limit <= 0) return fmt::format("it has reached {}", what);
     return fmt::format("at this rate it reaches {} in {}", what, ScansText(*finding.scans_to_limit, f.seconds_per_scan));
   };
-  const std::string alarm = fmt::format("{} alarmed at scan {} (CUSUM); the drift began about scan {}",
-                                        ChartList(finding.charts), finding.alarm_scan, finding.change_scan);
+  std::string rules;
+  for (Quantity q : finding.charts) {
+    const SeriesResult& series = SeriesOf(f, q);
+    const std::string name(series.chart.alarm ? ChartRuleName(series.chart.alarm_rule) : "?");
+    if (rules.find(name) == std::string::npos) rules += (rules.empty() ? "" : ", ") + name;
+  }
+  const std::string alarm = fmt::format("{} alarmed at scan {} ({}); the drift began about scan {}",
+                                        ChartList(finding.charts), finding.alarm_scan, rules, finding.change_scan);
   switch (finding.kind) {
     case FindingKind::kFixtureMoving:
       lines.push_back(fmt::format("The fixture is moving: the board's pose walks. {}.", alarm));
@@ -365,7 +371,7 @@ std::string MonitorReportText(const MonitorResult& result, const MonitorContext&
     for (const SeriesResult& series : f.series) {
       const std::vector<std::string> lines = RuleLines(series);
       if (lines.empty()) continue;
-      if (!any_rules) out += "\n  rules that fired (signals to look at; the verdict is the CUSUMs'):\n";
+      if (!any_rules) out += "\n  rules that fired (signals to look at; the verdict is the CUSUMs' and the EWMAs'):\n";
       any_rules = true;
       out += fmt::format("  {}:\n", QuantityTitle(series.quantity));
       for (const std::string& line : lines) out += fmt::format("    {}\n", line);
@@ -381,6 +387,7 @@ ordered_json MonitorReportJson(const MonitorResult& result, const MonitorContext
   json["records"] = context.records;
   json["baseline"] = context.options.baseline;
   json["cusum"] = {{"k", context.options.cusum_k}, {"h", context.options.cusum_h}, {"clip", context.options.cusum_clip}};
+  json["ewma"] = {{"lambda", context.options.ewma_lambda}, {"L", context.options.ewma_l}};
   json["in_control"] = result.in_control;
   ordered_json fixtures = ordered_json::array();
   for (const FixtureMonitor& f : result.fixtures) {
@@ -431,6 +438,8 @@ ordered_json MonitorReportJson(const MonitorResult& result, const MonitorContext
         c["center"] = Rounded(series.chart.center, 4);
         c["sigma"] = Rounded(series.chart.sigma, 4);
         c["alarm_scan"] = series.chart.alarm ? ordered_json(static_cast<long>(series.scan[*series.chart.alarm]))
+                                             : ordered_json();
+        c["alarm_rule"] = series.chart.alarm ? ordered_json(std::string(ChartRuleName(series.chart.alarm_rule)))
                                              : ordered_json();
         c["change_scan"] = series.chart.alarm ? ordered_json(static_cast<long>(series.scan[series.chart.change_point]))
                                               : ordered_json();
@@ -610,7 +619,7 @@ std::string ChartSvg(const SeriesResult& series, const FixtureMonitor& f, double
                          plot.X(change), plot.Y(std::clamp(y0, plot.y().lo, plot.y().hi)), plot.X(t.end_x),
                          plot.Y(std::clamp(t.at_end, plot.y().lo, plot.y().hi)));
     }
-    note = fmt::format("CUSUM alarm at scan {}", static_cast<long>(alarm));
+    note = fmt::format("{} alarm at scan {}", ChartRuleName(chart.alarm_rule), static_cast<long>(alarm));
   }
   // The figures beside the plot.
   const int d = DecimalsOf(series.quantity);
@@ -680,9 +689,11 @@ std::string MonitorReportSvg(const MonitorResult& result, const MonitorContext& 
                   "accepted scans),", context.options.baseline),
       "which sets the centre line (blue) and sigma; dashed red: 3 sigma (guarded: the upper 95 % bound of the "
       "baseline's sigma); red dot: beyond it.",
-      fmt::format("Red line: the CUSUM's alarm (k = {} sigma plus the centre's uncertainty, h = {} sigma), the "
-                  "verdict; dashed orange: where the drift began; orange line: its trend.",
-                  context.options.cusum_k, context.options.cusum_h)};
+      fmt::format("Red line: the first alarm of the CUSUM (k = {} sigma plus the centre's uncertainty, h = {} sigma) "
+                  "or the EWMA (lambda {}, {} of its sigmas), the verdict; dashed orange: where the drift began; "
+                  "orange line: its trend.",
+                  context.options.cusum_k, context.options.cusum_h, context.options.ewma_lambda,
+                  context.options.ewma_l)};
   for (std::size_t i = 0; i < legend.size(); ++i) {
     header += fmt::format("<text x=\"{}\" y=\"{}\" font-size=\"12\">{}</text>\n", kLeft, 46 + 16 * i,
                           SvgEscape(legend[i]));

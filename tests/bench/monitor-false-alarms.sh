@@ -32,7 +32,7 @@ for seed in range(1, shifts + 1):
             charts[chart] += 1
     for name, chart in board["charts"].items():
         for run in chart.get("rules", []):
-            if not run["rule"].startswith("cusum"):
+            if not run["rule"].startswith(("cusum", "ewma")):
                 signals[run["rule"]] += 1
 print(f"{alarmed} of {shifts} in-control shifts of {scans} scans alarmed "
       f"({1000 * alarmed / (shifts * scans):.3f} false alarms per 1000 scans, at most one counted per shift)")
