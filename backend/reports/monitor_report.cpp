@@ -689,19 +689,20 @@ std::string MonitorReportSvg(const MonitorResult& result, const MonitorContext& 
                   "accepted scans),", context.options.baseline),
       "which sets the centre line (blue) and sigma; dashed red: 3 sigma (guarded: the upper 95 % bound of the "
       "baseline's sigma); red dot: beyond it.",
-      fmt::format("Red line: the first alarm of the CUSUM (k = {} sigma plus the centre's uncertainty, h = {} sigma) "
-                  "or the EWMA (lambda {}, {} of its sigmas), the verdict; dashed orange: where the drift began; "
-                  "orange line: its trend.",
-                  context.options.cusum_k, context.options.cusum_h, context.options.ewma_lambda,
-                  context.options.ewma_l)};
+      fmt::format("Red line: the verdict, the first alarm of the CUSUM (k = {} sigma plus the centre's uncertainty, "
+                  "h = {} sigma)",
+                  context.options.cusum_k, context.options.cusum_h),
+      fmt::format("or of the EWMA (lambda {}, {} of its sigmas); dashed orange: where the drift began; orange line: "
+                  "its trend.",
+                  context.options.ewma_lambda, context.options.ewma_l)};
   for (std::size_t i = 0; i < legend.size(); ++i) {
     header += fmt::format("<text x=\"{}\" y=\"{}\" font-size=\"12\">{}</text>\n", kLeft, 46 + 16 * i,
                           SvgEscape(legend[i]));
   }
-  header += fmt::format("<text x=\"{}\" y=\"112\" font-size=\"14\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", kLeft,
+  header += fmt::format("<text x=\"{}\" y=\"128\" font-size=\"14\" font-weight=\"bold\" fill=\"{}\">{}</text>\n", kLeft,
                         result.in_control ? "#2ca02c" : "#d62728",
                         result.in_control ? "IN CONTROL" : "OUT OF CONTROL");
-  y = 128;
+  y = 144;
   for (const FixtureMonitor& f : result.fixtures) {
     body += fmt::format("<text x=\"{}\" y=\"{:.1f}\" font-size=\"15\" font-weight=\"bold\">fixture {}: {} scans, {} "
                         "accepted</text>\n",
