@@ -50,15 +50,7 @@ Case MakeCase(std::mt19937_64& rng) {
     robot.emplace_back(Uniform(rng, -0.005, 0.005), Uniform(rng, -0.005, 0.005));
   }
   c.trips = test::Present(test::SimulateTrips(fixture, truth, sensor, robot));
-  const double fault = Uniform(rng, 0, 1);
-  const std::size_t k = std::uniform_int_distribution<std::size_t>(0, 7)(rng);
-  if (fault < 0.1) {
-    c.trips[k].reset();
-  } else if (fault < 0.2) {
-    *c.trips[k] += Eigen::Vector2d(Uniform(rng, -4, 4), Uniform(rng, -4, 4));
-  } else if (fault < 0.3) {
-    *c.trips[k] += Eigen::Vector2d(Uniform(rng, -0.3, 0.3), Uniform(rng, -0.3, 0.3));
-  }
+  test::InjectTripFault(c.trips, rng, 0.1);
   // A previous scan half the time; one in five of those farther than
   // max_shift_mm (2 mm) from this one, so cycle_shift refuses some scans.
   if (Uniform(rng, 0, 1) < 0.5) {
