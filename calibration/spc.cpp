@@ -323,6 +323,9 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
       chart.alarm = i;
       chart.alarm_rule = ewma_up ? ChartRule::kEwmaUp : ChartRule::kEwmaDown;
       chart.alarm_direction = ewma_up ? Direction::kUp : Direction::kDown;
+      // Where the drift began: after the EWMA last stood on the centre
+      // line's other side (for a slow ramp nearer the start than the
+      // CUSUM's last zero, which its reference value k holds back).
       const std::optional<std::size_t>& other_side = ewma_up ? last_below : last_above;
       chart.change_point = other_side ? *other_side + 1 : 0;
     }
