@@ -259,6 +259,9 @@ struct Feeder {
   std::array<double, 4> PickPoint(int k) const;
 };
 
+// The cycle record's bound per file ([linuxcnc] record_max_cycles, its
+// range limits::kRecordMaxCycles): a week of the paper cell's cycles.
+inline constexpr int kDefaultRecordMaxCycles = 10000;
 // Pick point k (1 .. columns * rows) of a pallet, in the order of the
 // language's Pallet(n, k): along the first row from `first` to `last`, then
 // row after row toward `back` (the first column of the last row; `first`
@@ -276,6 +279,14 @@ struct LinuxCnc {
   char rotation_axis = 'C';      // the axis word u is commanded on: A, B or C
   int vacuum_sensor_input = 0;   // motion.digital-in-NN the gripper's vacuum sensor is wired to
   double vacuum_timeout_s = 0;   // how long a Pick/Place waits for the sensor before aborting (> 0)
+  // The cycle record (docs/monitor.md): the log file the runtime appends a
+  // record of every scan to (empty: none), how many scans a file holds
+  // before the runtime goes on in the other of its two files, and the HAL
+  // pin it reads the time from (empty: no clock).
+  std::string record_file;
+  int record_max_cycles = kDefaultRecordMaxCycles;
+  std::string record_clock_pin;
+  SourceRange record_file_range;  // the key, for messages
   SourceRange range;             // the [linuxcnc] table
 };
 

@@ -83,6 +83,9 @@ inline constexpr NumberRange kDifficultyLevel = Whole(1, 4);
 // An input or output bit of the robot controller; a LinuxCNC digital input.
 inline constexpr NumberRange kIoBit = Whole(kIoBitMin, kIoBitMax);
 inline constexpr NumberRange kLinuxCncInput = Whole(0, 63);  // [EMCMOT] num_dio: 64 (cell::kLinuxCncMaxDio)
+// [linuxcnc] record_max_cycles: scans per log file; at most what `smtcal
+// monitor` reads in one file (256 MiB) for a fixture of 32 trips.
+inline constexpr NumberRange kRecordMaxCycles = Whole(1, 100'000);
 // [measure]: the dwell before a reading; a transducer's slope (its size also
 // at least 0.1, checked by the reader) and its grooves; the external system's
 // first analog output (the set and repetition go on the next two).
@@ -112,6 +115,8 @@ inline constexpr NumberRange kSimCycles = Whole(1, kSimMaxCycles);
 inline constexpr NumberRange kSimSeed = Whole(0, 18446744073709551615.0);
 inline constexpr NumberRange kProbability = Closed(0, 1, "");
 inline constexpr NumberRange kDirtyMarkerMm = Closed(0, 10, "mm");
+// monitor --baseline: the accepted scans per fixture that set the charts.
+inline constexpr NumberRange kMonitorBaseline = Whole(2, 1'000'000);
 // table inverse --paper-tolerance: the paper solver's stopping tolerance.
 inline constexpr NumberRange kPaperToleranceMm = AboveZero(1, "mm");
 // import --vacuum: an output bit.

@@ -53,6 +53,30 @@ struct BoardPoseModel {
   double fixed_rotation_deg = 0;
 };
 
+// Slow changes of the cell, cycle by cycle (the drifts `smtcal monitor`
+// watches for). Cycle c (1, 2, ... of each Cycle statement) is off by
+// max(0, c - start_cycle) steps of each rate.
+struct DriftModel {
+  long start_cycle = 0;
+  Eigen::Vector2d board_mm_per_cycle = Eigen::Vector2d::Zero();  // the board's pose walks (the fixture wearing)
+  double board_deg_per_cycle = 0;                                // ... and turns
+  // The robot's scale changes (warming): F_true(n) gains s (n - about), s
+  // growing by this many ppm a cycle; the tables do not know it.
+  double robot_scale_ppm_per_cycle = 0;
+  Eigen::Vector2d robot_scale_about_mm = Eigen::Vector2d::Zero();
+  // The marker sensor's threshold: it trips this much later entering a
+  // marker and earlier leaving it (a dirty lens sees the markers smaller).
+  double sensor_threshold_mm_per_cycle = 0;
+  double sensor_accuracy_mm_per_cycle = 0;  // its scatter grows (added to the accuracy)
+
+  bool any() const {
+    return !board_mm_per_cycle.isZero() || board_deg_per_cycle != 0 || robot_scale_ppm_per_cycle != 0 ||
+           sensor_threshold_mm_per_cycle != 0 || sensor_accuracy_mm_per_cycle != 0;
+  }
+  // The steps of cycle c (1-based).
+  double Steps(long cycle) const { return cycle > start_cycle ? static_cast<double>(cycle - start_cycle) : 0.0; }
+};
+
 struct TruthSpec {
   std::string path;  // the truth file; empty: defaults
   TruthTables tables = TruthTables::kDerived;
@@ -81,6 +105,7 @@ struct TruthSpec {
   // false: no sensor error, no repeatability noise, no trip latency (and no
   // table perturbation for `derived`): F_true and the board pose alone decide.
   bool noise = true;
+  DriftModel drift;
 };
 
 // The true field outside the tables is scaled to its largest magnitude over

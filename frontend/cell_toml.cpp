@@ -1127,6 +1127,40 @@ std::optional<LinuxCnc> Loader::ReadLinuxCnc(const toml::table& table) {
   linuxcnc.vacuum_sensor_input =
       WholeIn(keys, "vacuum_sensor_input", limits::kLinuxCncInput, "motion.digital-in-NN").value_or(0);
   linuxcnc.vacuum_timeout_s = NumberIn(keys, "vacuum_timeout_s", limits::kTimeoutS).value_or(0);
+  // The cycle record: names LinuxCNC takes as they are written in a comment
+  // (LOGOPEN, #<_hal[...]>), so no parentheses, no spaces at their ends.
+  if (auto file = String(keys, "record_file", Need::kOptional, "a string: the log file's path")) {
+    linuxcnc.record_file_range = file->range;
+    const bool plain = !file->value.empty() && file->value.size() <= 200 &&
+                       file->value.find_first_of("()#%\n\r\t;") == std::string::npos && file->value.front() != ' ' &&
+                       file->value.back() != ' ';
+    if (!plain) {
+      diags_.Report(DiagKind::CellWrongType, file->range, "'record_file'",
+                    "a path of 1 to 200 characters without ( ) # % ; tabs or line ends, and no space at either end "
+                    "(LinuxCNC's LOGOPEN takes it as written)",
+                    fmt::format("'{}'", Printable(file->value)));
+    } else {
+      linuxcnc.record_file = file->value;
+    }
+  }
+  if (keys.Get("record_max_cycles") != nullptr) {
+    linuxcnc.record_max_cycles =
+        WholeIn(keys, "record_max_cycles", limits::kRecordMaxCycles, "scans per file").value_or(kDefaultRecordMaxCycles);
+  }
+  if (auto pin = String(keys, "record_clock_pin", Need::kOptional, "a string: a HAL pin's name")) {
+    const bool plain = !pin->value.empty() && pin->value.size() <= 47 &&
+                       std::all_of(pin->value.begin(), pin->value.end(), [](char c) {
+                         return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' || c == '-';
+                       });
+    if (!plain) {
+      diags_.Report(DiagKind::CellWrongType, pin->range, "'record_clock_pin'",
+                    "a HAL pin's name: 1 to 47 lowercase letters, digits, '.', '_' or '-' (LinuxCNC's interpreter "
+                    "reads #<_hal[...]> in lowercase)",
+                    fmt::format("'{}'", Printable(pin->value)));
+    } else {
+      linuxcnc.record_clock_pin = pin->value;
+    }
+  }
   keys.Finish();
   if (diags_.error_count() != errors_before) return std::nullopt;
   return linuxcnc;

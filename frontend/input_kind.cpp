@@ -119,6 +119,9 @@ InputKind GuessInputKind(std::string_view name, std::string_view text) {
     }
   }
   for (std::string_view line : lines) {
+    if (line.starts_with("smtcal-record ")) return InputKind::kRecordLog;
+  }
+  for (std::string_view line : lines) {
     // A program says so at the start of a line; it is never another kind.
     for (std::string_view word : {"Function", "Program", "Point", "Fixture", "Pallet", "Taught", "Vacuum"}) {
       if (StartsWithWord(line, word)) return InputKind::kProgram;
@@ -171,6 +174,7 @@ std::string_view InputKindName(InputKind kind) {
     case InputKind::kJson: return "a JSON file";
     case InputKind::kSvg: return "an SVG picture";
     case InputKind::kNgc: return "an RS274NGC program (LinuxCNC)";
+    case InputKind::kRecordLog: return "a log of cycle records";
   }
   return "";
 }
@@ -189,6 +193,7 @@ std::string InputKindAdvice(InputKind kind, std::string_view name) {
     case InputKind::kCadList:
       return fmt::format("make a program of it with 'smtcal import {} --cell CELL.toml -o BOARD.place'", file);
     case InputKind::kNgc: return "it is smtcal's output for LinuxCNC, not one of its inputs";
+    case InputKind::kRecordLog: return fmt::format("read it with 'smtcal monitor {} --cell CELL.toml'", file);
     case InputKind::kUnknown:
     case InputKind::kToml:
     case InputKind::kJson:

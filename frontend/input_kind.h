@@ -33,6 +33,7 @@ enum class InputKind {
   kJson,
   kSvg,
   kNgc,              // RS274NGC
+  kRecordLog,        // cycle records: a line 'smtcal-record N ...'
 };
 
 InputKind GuessInputKind(std::string_view name, std::string_view text);

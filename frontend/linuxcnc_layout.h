@@ -12,7 +12,7 @@ namespace smtcal {
 namespace linuxcnc_layout {
 inline constexpr int kFirst = 31;    // the runtime's numbered parameters
 inline constexpr int kLast = 4999;
-inline constexpr int kScratch = 4700;  // #4700..#4999: the estimators' scratch arrays; data ends below
+inline constexpr int kScratch = 4700;  // #4700..#4963: the estimators' scratch arrays, then the cycle record; data ends below
 inline constexpr int kVersion = 31;  // 1 once smtcal_data ran
 inline constexpr int kRegionCount = 32;
 inline constexpr int kFixtureCount = 33;
@@ -34,7 +34,16 @@ inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 
                      kFxTripNominalAt = 29, kFxTripsAt = 30, kFxTrippedAt = 31, kFxCalibratedAt = 32,
                      kFxScanPathsAt = 33, kFxHasFix = 34, kFxFix = 35, kFxStatus = 41, kFxFailedTrip = 42,
                      kFxCheckValue = 43 /* + code 1..11 */, kFxCheckEvaluated = 55 /* + code */, kFxS = 67,
-                     kFxScale = 73, kFxLatchFeed = 74, kFxRecordSize = 80;
+                     kFxScale = 73, kFxLatchFeed = 74, kFxRecordCycles = 75, kFxRecordSize = 80;
+// The cycle record (backend/linuxcnc/linuxcnc_record.h): the line buffer the
+// LOG comments print, above the estimators' scratch (#4700..#4963); and the
+// counters that bound the log files, kept across runs in the machine's
+// parameter file.
+inline constexpr int kRecordBuffer = 4969;   // #4969..#4993: fixture, cycle, status, trip, time, S1..S3, checks, trip
+inline constexpr int kRecordSegment = 4996;  // the log's segment: one more at every change of file
+inline constexpr int kRecordFile = 4997;     // 0: record_file, 1: record_file.1
+inline constexpr int kRecordCount = 4998;    // scans recorded in that file
+inline constexpr int kRecordKept = 4999;     // 1 when the parameter file keeps #4996..#4999
 // Region record offsets.
 inline constexpr int kRgXLo = 0, kRgXHi = 1, kRgYLo = 2, kRgYHi = 3, kRgDomain = 4, kRgContraction = 8,
                      kRgIterationBound = 9, kRgOutside = 10, kRgDxAt = 11, kRgDyAt = 12, kRgRecordSize = 13;

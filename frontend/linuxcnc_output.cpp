@@ -116,6 +116,9 @@ class DataReader {
         ended = true;
         continue;
       }
+      // The cycle record's begin line (smtcal_record_open.ngc, written for the
+      // cell): no data of the cell.
+      if (in_sub && line.starts_with("o<smtcal_record_open> call")) continue;
       if (!in_sub || !line.starts_with('#')) return ReadError{number, "a line that is not a parameter of o<smtcal_data>"};
       if (line.starts_with(L::kRuntimeIdParameter)) continue;  // the runtime's identity, not the cell's data
       // #N = value[  ; what]

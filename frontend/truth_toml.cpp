@@ -44,7 +44,7 @@ class Reader {
     const std::size_t errors_before = diags_.error_count();
     TruthSpec spec;
     spec.path = path;
-    CheckKeys(root, "the truth file", {"noise", "field", "region", "board", "sensor", "robot"});
+    CheckKeys(root, "the truth file", {"noise", "field", "region", "board", "sensor", "robot", "drift"});
     if (std::optional<bool> noise = Bool(root, "noise")) spec.noise = *noise;
     if (const toml::table* field = Table(root, "field")) ReadField(*field, spec);
     if (const toml::table* board = Table(root, "board")) ReadBoard(*board, spec.board);
@@ -61,6 +61,7 @@ class Reader {
       if (spec.uncalibrated_correlation_mm) CheckTrueFieldGrid(*robot, *spec.uncalibrated_correlation_mm);
       spec.servo_period_s = Number(*robot, "servo_period_s", Closed(0, 1, "s"));
     }
+    if (const toml::table* drift = Table(root, "drift")) ReadDrift(*drift, spec.drift);
     for (const toml::table* region : Tables(root, "region")) ReadRegion(*region, spec);
     if (diags_.error_count() != errors_before) return std::nullopt;
     return spec;
@@ -99,6 +100,21 @@ class Reader {
     board.rotation_sd_deg = Number(table, "rotation_sd_deg", Closed(0, 5, "deg")).value_or(board.rotation_sd_deg);
     board.rotation_max_deg = Number(table, "rotation_max_deg", Closed(0, 10, "deg")).value_or(board.rotation_max_deg);
     board.fixed_rotation_deg = Number(table, "fixed_rotation_deg", Closed(-10, 10, "deg")).value_or(board.fixed_rotation_deg);
+  }
+
+  void ReadDrift(const toml::table& table, DriftModel& drift) {
+    CheckKeys(table, "[drift]",
+              {"start_cycle", "board_mm_per_cycle", "board_deg_per_cycle", "robot_scale_ppm_per_cycle",
+               "robot_scale_about_mm", "sensor_threshold_mm_per_cycle", "sensor_accuracy_mm_per_cycle"});
+    if (std::optional<double> start = Number(table, "start_cycle", Whole(0, 1e6))) {
+      drift.start_cycle = static_cast<long>(*start);
+    }
+    drift.board_mm_per_cycle = Point(table, "board_mm_per_cycle", 0.1).value_or(drift.board_mm_per_cycle);
+    drift.board_deg_per_cycle = Number(table, "board_deg_per_cycle", Closed(-0.01, 0.01, "deg")).value_or(0);
+    drift.robot_scale_ppm_per_cycle = Number(table, "robot_scale_ppm_per_cycle", Closed(-100, 100, "ppm")).value_or(0);
+    drift.robot_scale_about_mm = Point(table, "robot_scale_about_mm", 1e5).value_or(drift.robot_scale_about_mm);
+    drift.sensor_threshold_mm_per_cycle = Number(table, "sensor_threshold_mm_per_cycle", Closed(-0.01, 0.01, "mm")).value_or(0);
+    drift.sensor_accuracy_mm_per_cycle = Number(table, "sensor_accuracy_mm_per_cycle", Closed(0, 0.01, "mm")).value_or(0);
   }
 
   void ReadRegion(const toml::table& table, TruthSpec& spec) {

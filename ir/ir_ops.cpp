@@ -106,6 +106,13 @@ const PointExpr* MotionTarget(const Stmt& stmt) {
 
 PointExpr* MotionTarget(Stmt& stmt) { return const_cast<PointExpr*>(MotionTarget(std::as_const(stmt))); }
 
+std::string ProgramName(const Program& program) {
+  for (const StmtPtr& item : program.items) {
+    if (const auto* decl = std::get_if<ProgramDecl>(&item->node)) return decl->name;
+  }
+  return "program";
+}
+
 const Stmt* CorrectedHeader(const Program& program) {
   for (const StmtPtr& stmt : program.items) {
     const auto* comment = std::get_if<Comment>(&stmt->node);

@@ -4,6 +4,7 @@
 // (the parser maps tokens to the IR in frontend/parse.cpp).
 #pragma once
 
+#include <string>
 #include <string_view>
 
 #include "ir/ir.h"
@@ -34,6 +35,9 @@ inline constexpr std::string_view kCorrectedHeaderPrefix = " Corrected by smtcal
 // The statement holding that comment among the program's leading comments,
 // or null: the program is not smtcal output.
 const Stmt* CorrectedHeader(const Program& program);
+
+// The name the program's `Program NAME` declares, or "program".
+std::string ProgramName(const Program& program);
 
 // Binding strength, from the grammar's expr rule (ANTLR gives the earlier
 // alternative the higher precedence); higher binds tighter. All binary

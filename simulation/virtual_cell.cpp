@@ -83,8 +83,9 @@ struct PlacementPlan {
 
 struct CyclePlan {
   int fixture = -1;
+  int cell_fixture = -1;  // the fixture's index in the cell (the records')
   std::vector<PlacementPlan> placements;
-  double scan_s = 0, motion_s = 0;
+  double scan_s = 0, motion_s = 0, total_s = 0;
 };
 
 Eigen::Vector2d MeanShift(const cell::Region* region) {
@@ -147,8 +148,9 @@ std::optional<Eigen::Affine3d> UncheckedPose(const cell::Fixture& fixture, const
 // `robot_mm` off its path: the commanded point then, or nullopt when the real
 // path does not cross the visible edge.
 // `late_mm`: how far past the crossing the controller latched the trip,
-// along the leg.
-std::optional<Eigen::Vector2d> SimulateTrip(const TrueField& field, const Eigen::Vector2d& from,
+// along the leg. `actual_of`: where the robot really is for a command.
+template <typename Actual>
+std::optional<Eigen::Vector2d> SimulateTrip(const Actual& actual_of, const Eigen::Vector2d& from,
                                             const Eigen::Vector2d& to, const Eigen::Vector2d& a,
                                             const Eigen::Vector2d& b, double sensor_mm,
                                             const Eigen::Vector2d& robot_mm, double late_mm) {
@@ -157,7 +159,7 @@ std::optional<Eigen::Vector2d> SimulateTrip(const TrueField& field, const Eigen:
   const double offset = normal.dot(a) + sensor_mm;
   auto real = [&](double t) -> Eigen::Vector2d {
     const Eigen::Vector2d commanded = from + t * (to - from);
-    const Eigen::Vector2d actual = field.Actual(commanded);
+    const Eigen::Vector2d actual = actual_of(commanded);
     return actual + robot_mm;
   };
   auto side = [&](double t) { return normal.dot(real(t)) - offset; };
@@ -232,9 +234,10 @@ class Simulator {
     // keeps only the first): the picture must show every part.
     while (scatter_stride_ > 1 && per_round > 1 && std::gcd(scatter_stride_, per_round) != 1) ++scatter_stride_;
     previous_.assign(kSimModes.size(), std::vector<std::optional<Eigen::Affine3d>>(state_.fixtures.size()));
+    record_cycles_.assign(cell_.fixtures.size(), 0);
     for (int n = 0; n < options_.cycles; ++n) {
       for (const CyclePlan& plan : plans_) {
-        RunCycle(plan, result);
+        RunCycle(plan, n + 1, result);
         ++result.cycles;
         result.placements_planned += static_cast<long>(plan.placements.size());
       }
@@ -254,6 +257,10 @@ class Simulator {
       plan.fixture = state_.FindFixture(estimate.fixture);
       plan.scan_s = estimate.scan_s;
       plan.motion_s = estimate.motion_s;
+      plan.total_s = estimate.total_s();
+      for (std::size_t k = 0; k < cell_.fixtures.size() && plan.fixture >= 0; ++k) {
+        if (&cell_.fixtures[k] == state_.fixtures[plan.fixture].cell_fixture) plan.cell_fixture = static_cast<int>(k);
+      }
       scan_s_ += plan.fixture >= 0 ? estimate.scan_s : 0.0;
       total_s_ += estimate.total_s();
       for (const TraceEvent& event : state_.cycle_traces.at(estimate.cycle)) {
@@ -369,7 +376,18 @@ class Simulator {
     return repeatability_mm_ * Eigen::Vector2d(u, v);
   }
 
-  void RunCycle(const CyclePlan& plan, SimResult& result) {
+  // Where the robot really is for a command this cycle: the true field and
+  // the drift of its scale.
+  Eigen::Vector2d Actual(const Eigen::Vector2d& commanded) const {
+    const Eigen::Vector2d actual = field_.Actual(commanded);
+    if (drift_scale_ == 0) return actual;
+    return actual + drift_scale_ * (commanded - truth_.drift.robot_scale_about_mm);
+  }
+
+  void RunCycle(const CyclePlan& plan, int cycle, SimResult& result) {
+    const DriftModel& drift = truth_.drift;
+    const double steps = drift.Steps(cycle);
+    drift_scale_ = 1e-6 * drift.robot_scale_ppm_per_cycle * steps;
     // The draws, in a fixed order whatever the options: fault decisions,
     // board pose, scan noise, placement noise.
     const bool missed = random_.Chance(options_.missed_trip_rate);
@@ -385,13 +403,17 @@ class Simulator {
     bool injected = false;
     if (fixture != nullptr) {
       board = DrawBoard(*fixture, truth_.board, random_);
+      if (steps > 0) {
+        board = PlanarFix(FixOrigin(board) + steps * drift.board_mm_per_cycle,
+                          FixAngleRad(board) + steps * drift.board_deg_per_cycle * kRadPerDeg);
+      }
       if (beyond) {
         const double shift = fixture->max_shift_mm + beyond_extra;
         board = PlanarFix(fixture->origin_mm + shift * Eigen::Vector2d(std::cos(beyond_angle), std::sin(beyond_angle)),
                           FixAngleRad(board));
         ++result.injected_beyond;
       }
-      trips = Scan(*fixture, board);
+      trips = Scan(*fixture, board, steps);
       if (missed && !trips.empty()) {
         trips[std::min(trips.size() - 1, static_cast<std::size_t>(missed_pick * static_cast<double>(trips.size())))] =
             std::nullopt;
@@ -418,6 +440,10 @@ class Simulator {
       std::optional<Eigen::Affine3d> fix_n;
       if (UsesPeriphery(mode) && fixture != nullptr) {
         ScanResult scan = ScanFixture(*fixture, trips, ScanOptionsFor(mode, *fixture, m, plan.fixture));
+        if (options_.record && mode == SimMode::kImproved && plan.cell_fixture >= 0) {
+          long& number = record_cycles_[static_cast<std::size_t>(plan.cell_fixture)];
+          result.records.push_back(RecordOfScan(plan.cell_fixture, ++number, clock_s_ + plan.scan_s, scan));
+        }
         fix_n = scan.fix;
         if (!scan.ok()) {
           std::string check(ScanCheckName(scan.FirstFailure()->check));
@@ -442,7 +468,7 @@ class Simulator {
       for (std::size_t j = 0; j < plan.placements.size(); ++j) {
         const PlacementPlan& p = plan.placements[j];
         const Eigen::Affine3d* fix = fix_n ? &*fix_n : p.fixture >= 0 ? &state_.fixtures[p.fixture].nominal : nullptr;
-        const Eigen::Vector2d landed = field_.Actual(Command(mode, p, fix)) + noise[j];
+        const Eigen::Vector2d landed = Actual(Command(mode, p, fix)) + noise[j];
         const Eigen::Vector2d belongs = p.fixture >= 0 ? ToBase(board, p.true_point) : p.true_point;
         const Eigen::Vector2d error = landed - belongs;
         const double error_mm = error.norm();
@@ -460,23 +486,41 @@ class Simulator {
       }
     }
     placement_slot_ += static_cast<long>(plan.placements.size());
+    clock_s_ += plan.total_s;
   }
 
   // The commanded trips of one scan with the board at `board`.
-  std::vector<std::optional<Eigen::Vector2d>> Scan(const cell::Fixture& fixture, const Eigen::Affine3d& board) {
+  // `steps`: the drift's steps this cycle (DriftModel).
+  std::vector<std::optional<Eigen::Vector2d>> Scan(const cell::Fixture& fixture, const Eigen::Affine3d& board,
+                                                   double steps) {
     const Eigen::Affine3d nominal = NominalFix(fixture);
-    const double accuracy = truth_.noise ? truth_.sensor_accuracy_mm.value_or(fixture.sensor_accuracy_mm) : 0.0;
+    const DriftModel& drift = truth_.drift;
+    const double accuracy = (truth_.noise ? truth_.sensor_accuracy_mm.value_or(fixture.sensor_accuracy_mm) : 0.0) +
+                            steps * drift.sensor_accuracy_mm_per_cycle;
+    const double threshold_mm = steps * drift.sensor_threshold_mm_per_cycle;
     const double latency_mm = fixture.TripLatchSpeedMmS() * servo_period_s_;
     const std::vector<ExpectedTrip>& expected = ExpectedFor(fixture);
     std::vector<std::optional<Eigen::Vector2d>> trips;
+    std::vector<std::size_t> on_path(fixture.scan_paths.size(), 0);
+    auto actual = [this](const Eigen::Vector2d& commanded) { return Actual(commanded); };
     for (const ExpectedTrip& e : expected) {
       const Eigen::Vector2d robot = RobotNoise();
-      const double sensor = accuracy * random_.Uniform(-1, 1);
+      double sensor = accuracy * random_.Uniform(-1, 1);
       const double late = latency_mm * random_.Uniform01();
       const auto& points = fixture.scan_paths[e.path].points;
       const cell::MarkerEdge& edge = fixture.edges[static_cast<std::size_t>(e.edge)];
-      trips.push_back(SimulateTrip(field_, ToBase(nominal, points[e.leg]), ToBase(nominal, points[e.leg + 1]),
-                                   ToBase(board, edge.from), ToBase(board, edge.to), sensor, robot, late));
+      const Eigen::Vector2d from = ToBase(nominal, points[e.leg]), to = ToBase(nominal, points[e.leg + 1]);
+      const Eigen::Vector2d a = ToBase(board, edge.from), b = ToBase(board, edge.to);
+      // Every path starts off the markers, so its trips alternate: entering
+      // a marker, leaving it. A threshold that sees the markers smaller
+      // moves each edge line into its marker.
+      const bool entering = on_path[e.path]++ % 2 == 0;
+      if (threshold_mm != 0) {
+        const Eigen::Vector2d normal = Eigen::Vector2d(-(b - a).y(), (b - a).x()).normalized();
+        const double into = normal.dot(to - from) >= 0 ? 1.0 : -1.0;  // the leg crosses along +normal
+        sensor += threshold_mm * (entering ? into : -into);
+      }
+      trips.push_back(SimulateTrip(actual, from, to, a, b, sensor, robot, late));
     }
     return trips;
   }
@@ -510,6 +554,9 @@ class Simulator {
   long placement_slot_ = 0;  // planned placements before this cycle
   double min_tolerance_mm_ = 0;
   double scan_s_ = 0, total_s_ = 0;
+  double drift_scale_ = 0;           // the robot's scale drift this cycle (DriftModel)
+  double clock_s_ = 0;               // the cycle-time estimate's clock at the start of this cycle
+  std::vector<long> record_cycles_;  // per cell fixture: scans recorded
 };
 
 }  // namespace

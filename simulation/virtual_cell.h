@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 
 #include "calibration/capability.h"
+#include "calibration/cycle_record.h"
 #include "passes/correction/compile_state.h"
 #include "simulation/true_field.h"
 
@@ -64,6 +65,9 @@ struct SimOptions {
   double dirty_marker_mm = 0.5;
   double board_beyond_rate = 0;   // the board shifted beyond max_shift_mm (by 0.1..1 mm more)
   std::size_t scatter_points = 2000;  // per mode, kept for the picture: every k-th planned placement
+  // Keep the record of every scan of the improved mode (the runtime's), as
+  // the controller would log it (SimResult::records).
+  bool record = false;
 };
 
 struct ModeResult {
@@ -103,6 +107,10 @@ struct SimResult {
   bool accuracy_assumed = false;        // not declared: kAssumedUncalibratedAccuracyMm
   std::vector<std::string> regions;     // the cell's region names, for by_region
   std::vector<ModeResult> modes; // in kSimModes order
+  // With SimOptions::record: the improved mode's scans, in the order they
+  // ran, numbered per fixture from 1; the fixture is its index in the cell,
+  // the time the cycle-time estimate's clock at the end of the scan.
+  std::vector<CycleRecord> records;
 };
 
 // The compiled program must have passed the correction passes without error.

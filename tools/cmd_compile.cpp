@@ -62,13 +62,6 @@ void AddHeader(ir::Program& program, const cell::Cell& cell) {
                        std::make_move_iterator(header.end()));
 }
 
-std::string ProgramName(const ir::Program& program) {
-  for (const ir::StmtPtr& item : program.items) {
-    if (const auto* decl = std::get_if<ir::ProgramDecl>(&item->node)) return decl->name;
-  }
-  return "program";
-}
-
 void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}, {"--ini", opt.ini}},
                  {{"-o", opt.output, opt.target == "linuxcnc"}, {"--report", opt.report}})) {
@@ -139,7 +132,7 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
                       fixture.name, kCRuntimeMaxTrips));
       return;
     }
-    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ProgramName(compiled.program));
+    text = EmitCRuntimeData(*compiled.cell, CRuntimeFixturePoints(state), ir::ProgramName(compiled.program));
   } else if (opt.target == "place") {
     AddHeader(compiled.program, *compiled.cell);
   }

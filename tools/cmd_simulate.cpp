@@ -12,7 +12,9 @@
 
 #include "base/json_text.h"
 #include "backend/reports/compile_report.h"
+#include "backend/c/record_text.h"
 #include "backend/reports/simulate_report.h"
+#include "base/text_output.h"
 #include "calibration/cell.h"
 #include "calibration/limits.h"
 #include "frontend/parse.h"
@@ -22,6 +24,7 @@
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
 #include "simulation/virtual_cell.h"
+#include "ir/ir_ops.h"
 #include "tools/commands.h"
 #include "tools/compile_pipeline.h"
 
@@ -33,9 +36,29 @@ struct SimulateOptions {
   std::string cell_path;
   std::string truth_path;
   std::string svg;
+  std::string record;
   bool json = false;
   SimOptions sim;
 };
+
+// The decimals of a simulated record: 1e-9 mm or deg, finer than anything
+// the simulation models, in the plain decimals of the C runtime's formatter
+// (the LinuxCNC runtime writes millionths and e-6, to 1e-15; docs/monitor.md).
+constexpr int kRecordDecimals = 9;
+
+// The improved mode's scans as the controller would log them (docs/monitor.md).
+Status WriteRecord(const std::string& path, const SimResult& result, const cell::Cell& cell) {
+  Result<std::unique_ptr<TextOutput>> opened = TextOutput::Open(path);
+  if (!opened) return opened.error();
+  TextOutput& out = *opened.value();
+  RecordBegin begin;
+  begin.cell = cell.name;
+  for (const cell::Fixture& fixture : cell.fixtures) begin.fixtures.push_back({fixture.name, ExpectedTrips(fixture).size()});
+  begin.clock = "simulate";
+  out.Append(RecordBeginText(begin));
+  for (const CycleRecord& record : result.records) out.Append(CycleRecordText(record, kRecordDecimals));
+  return out.Commit();
+}
 
 // Placements the compile-time trace could not place (warned), and whether
 // any Cycle places anything at all.
@@ -106,7 +129,7 @@ bool WithinPlacementLimit(const CompileState& state, const SimOptions& sim, Glob
 
 void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   if (FilesClash({{"PROGRAM", opt.program_path}, {"--cell", opt.cell_path}, {"--truth", opt.truth_path}},
-                 {{"--svg", opt.svg}, {"the report", "-"}})) {
+                 {{"--svg", opt.svg}, {"--record", opt.record}, {"the report", "-"}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -143,10 +166,18 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   if (diags.has_errors()) return;
 
   if (!WithinPlacementLimit(state, opt.sim, options) || !FitsInMemory(state, opt.sim, options)) return;
-  SimResult result = Simulate(state, truth, opt.sim);
+  SimOptions sim = opt.sim;
+  sim.record = !opt.record.empty();
+  SimResult result = Simulate(state, truth, sim);
   SimulateContext context{opt.program_path, &*compiled.cell, &truth, over_budget};
   if (!opt.svg.empty()) {
     if (Status written = WriteFileAtomically(opt.svg, SimulateReportSvg(result, context)); !written) {
+      options.exit_code = ReportIoError(written.error());
+      return;
+    }
+  }
+  if (!opt.record.empty()) {
+    if (Status written = WriteRecord(opt.record, result, *compiled.cell); !written) {
       options.exit_code = ReportIoError(written.error());
       return;
     }
@@ -157,6 +188,10 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
     return;
   }
   if (!opt.svg.empty()) SayDone(options, opt.svg, fmt::format("wrote the picture {}", opt.svg));
+  if (!opt.record.empty()) {
+    SayDone(options, opt.record,
+            fmt::format("wrote {} cycle records to {} (read them with smtcal monitor)", result.records.size(), opt.record));
+  }
 }
 
 }  // namespace
@@ -182,6 +217,9 @@ void AddSimulateCommand(CLI::App& app, GlobalOptions& options) {
       ->capture_default_str();
   simulate->add_flag("--json", opt.json, "print the report as JSON");
   simulate->add_option("--svg", opt.svg, "also write a picture: error scatter per mode and histograms");
+  simulate->add_option("--record", opt.record,
+                       "also write the record of every scan of the improved mode, as the controller's runtime logs "
+                       "it (docs/monitor.md; read it with smtcal monitor)");
   AddNumberOption(*simulate, "--missed-trip-rate", opt.sim.missed_trip_rate,
                   "fault injection: probability per cycle that the sensor misses one trip", limits::kProbability);
   AddNumberOption(*simulate, "--dirty-marker-rate", opt.sim.dirty_marker_rate,

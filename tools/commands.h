@@ -111,5 +111,6 @@ bool LoadMeasurePlan(const std::string& plan_path, const std::string& cell_path,
                      std::optional<measure::LoadedPlan>& plan);
 void AddSetupSheetCommand(CLI::App& app, GlobalOptions& options);
 void AddScanCommand(CLI::App& app, GlobalOptions& options);
+void AddMonitorCommand(CLI::App& app, GlobalOptions& options);
 
 }  // namespace smtcal::tools

@@ -222,6 +222,7 @@ int main(int argc, char** argv) {
   AddScanCommand(app, options);
   AddMeasureCommand(app, options);
   AddSetupSheetCommand(app, options);
+  AddMonitorCommand(app, options);
   int exit_code = Prescan(argc, argv);
   try {
     if (exit_code == kExitOk) exit_code = Run(app, argc, argv, options);

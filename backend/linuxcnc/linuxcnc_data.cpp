@@ -15,6 +15,7 @@
 
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/embedded_files.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/check.h"
 #include "calibration/fixture_geometry.h"
@@ -208,6 +209,7 @@ void AppendFixture(Layout& layout, const cell::Fixture& fixture, int directory_e
   layout.Set(at + L::kFxLatchFeed, fixture.latch_speed_mm_s * 60, n + ": latch feed mm/min; 0: one stage");
   layout.Set(at + L::kFxHasFix, 0, n + ": not scanned yet");
   layout.Set(at + L::kFxStatus, 0, n + ": last scan status");
+  layout.Set(at + L::kFxRecordCycles, 0, n + ": scans recorded since the start");
 
   const int edges_at = layout.Reserve(trips);
   layout.Set(at + L::kFxTripEdgeAt, edges_at, n + ": trip edges at");
@@ -281,6 +283,8 @@ long LinuxCncRuntimeId(const cell::Cell& cell) {
   for (const EmbeddedFile& file : LinuxCncRuntimeFiles()) hash = Fnv1a(Fnv1a(hash, file.name), file.text);
   hash = Fnv1a(hash, DataText(cell, std::nullopt));
   hash = Fnv1a(hash, EmitLinuxCncScanAbort(cell));
+  hash = Fnv1a(hash, EmitLinuxCncRecord(cell));
+  hash = Fnv1a(hash, EmitLinuxCncRecordOpen(cell));
   return static_cast<long>(hash & 0x7fffffffu);
 }
 
@@ -325,6 +329,7 @@ std::string DataText(const cell::Cell& cell, std::optional<long> id) {
   }
   out += layout.Text();
   out += fmt::format("#{} = {}  ; loaded: layout version\n", L::kVersion, L::kLayoutVersion);
+  out += "o<smtcal_record_open> call  ; the cycle record: its begin line (smtcal_record_open.ngc)\n";
   out += "o<smtcal_data> endsub\n";
   return out;
 }

@@ -34,6 +34,7 @@
 #include "backend/c/c_data.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
 #include "backend/linuxcnc/linuxcnc_dry_run.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "ir/constant_fold.h"
 #include "ir/ir_ops.h"
@@ -1093,7 +1094,9 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
                                            const std::string& program_path, TextOutput& main, Diagnostics& diags) {
   SMTCAL_CHECK(state.cell != nullptr, "the linuxcnc target needs a compiled program");
   const cell::Cell& cell = *state.cell;
-  if (std::optional<std::string> problem = LinuxCncDataProblem(cell)) {
+  std::optional<std::string> problem = LinuxCncDataProblem(cell);
+  if (!problem) problem = LinuxCncRecordProblem(cell);
+  if (problem) {
     // At the fixture whose scan is too long when one is, else at the cell.
     SourceRange where(SourceLoc{cell.file, 1, 1});
     for (const cell::Fixture& fixture : cell.fixtures) {
@@ -1118,6 +1121,8 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
   output.subroutines = LinuxCncRuntimeFiles();
   output.subroutines.push_back({"smtcal_data.ngc", EmitLinuxCncData(cell)});
   output.subroutines.push_back({"smtcal_scan_abort.ngc", EmitLinuxCncScanAbort(cell)});
+  output.subroutines.push_back({"smtcal_record.ngc", EmitLinuxCncRecord(cell)});
+  output.subroutines.push_back({"smtcal_record_open.ngc", EmitLinuxCncRecordOpen(cell)});
   std::sort(output.subroutines.begin(), output.subroutines.end(),
             [](const EmbeddedFile& a, const EmbeddedFile& b) { return a.name < b.name; });
   return output;
@@ -1126,7 +1131,8 @@ std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const Com
 std::string LinuxCncReviewText(const LinuxCncOutput& output, std::string_view main_text) {
   std::string text = fmt::format("(smtcal file: {})\n{}", output.main_name, main_text);
   for (const EmbeddedFile& file : output.subroutines) {
-    if (file.name == "smtcal_data.ngc" || file.name == "smtcal_scan_abort.ngc") {
+    if (file.name == "smtcal_data.ngc" || file.name == "smtcal_scan_abort.ngc" || file.name == "smtcal_record.ngc" ||
+        file.name == "smtcal_record_open.ngc") {
       text += fmt::format("(smtcal file: subroutines/{})\n{}", file.name, file.text);
     }
   }

@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "calibration/cycle_record.h"
+
 namespace smtcal {
 namespace {
 
@@ -29,15 +31,7 @@ constexpr std::array<std::string_view, 11> kMessages = {
 
 }  // namespace
 
-std::string LinuxCncMessageName(std::string_view name) {
-  std::string out;
-  for (char c : name) {
-    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                       c == '-' || c == '.';
-    out += plain ? c : '_';
-  }
-  return out;
-}
+std::string LinuxCncMessageName(std::string_view name) { return name.empty() ? std::string() : RecordName(name); }
 
 std::string EmitLinuxCncScanAbort(const cell::Cell& cell) {
   std::string out = fmt::format(

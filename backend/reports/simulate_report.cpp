@@ -100,6 +100,29 @@ nlohmann::json ProcessJson(const ModeResult& m, const SimResult& result) {
   return {{"overall", CapabilityJson(m.overall.Result())}, {"regions", regions}};
 }
 
+// The drifts of the run, per cycle from start_cycle on: "" without any.
+std::string DriftText(const DriftModel& drift) {
+  if (!drift.any()) return "";
+  std::vector<std::string> parts;
+  if (!drift.board_mm_per_cycle.isZero()) {
+    parts.push_back(fmt::format("board ({}, {}) mm", drift.board_mm_per_cycle.x(), drift.board_mm_per_cycle.y()));
+  }
+  if (drift.board_deg_per_cycle != 0) parts.push_back(fmt::format("board {}°", drift.board_deg_per_cycle));
+  if (drift.robot_scale_ppm_per_cycle != 0) {
+    parts.push_back(fmt::format("robot scale {} ppm about ({}, {})", drift.robot_scale_ppm_per_cycle,
+                                drift.robot_scale_about_mm.x(), drift.robot_scale_about_mm.y()));
+  }
+  if (drift.sensor_threshold_mm_per_cycle != 0) {
+    parts.push_back(fmt::format("sensor threshold {} mm", drift.sensor_threshold_mm_per_cycle));
+  }
+  if (drift.sensor_accuracy_mm_per_cycle != 0) {
+    parts.push_back(fmt::format("sensor accuracy +{} mm", drift.sensor_accuracy_mm_per_cycle));
+  }
+  std::string list;
+  for (std::size_t i = 0; i < parts.size(); ++i) list += (i == 0 ? "" : ", ") + parts[i];
+  return fmt::format("; drifting per cycle after cycle {}: {}", drift.start_cycle, list);
+}
+
 }  // namespace
 
 std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
@@ -131,9 +154,9 @@ std::string DescribeTruth(const TruthSpec& truth, const cell::Cell& cell) {
                          truth.about_mm.x(), truth.about_mm.y());
   }
   const double servo_period_s = truth.noise ? truth.servo_period_s.value_or(cell.robot.servo_period_s) : 0.0;
-  return fmt::format("{}; {}; sensor ±{} mm, repeatability ±{} mm (uniform), trips latched up to {} s late{}", field,
+  return fmt::format("{}; {}; sensor ±{} mm, repeatability ±{} mm (uniform), trips latched up to {} s late{}{}", field,
                      BoardText(truth.board), SensorAccuracy(truth, cell), Repeatability(truth, cell), servo_period_s,
-                     truth.noise ? "" : ", noise off");
+                     truth.noise ? "" : ", noise off", DriftText(truth.drift));
 }
 
 std::string SimulateReportText(const SimResult& result, const SimulateContext& context) {

@@ -24,6 +24,9 @@
 //   landing  where each part really lands: the command through the cell's
 //            tables (the robot's error as the cell describes it) into the
 //            board's true frame, against the programmed point.
+// A cycle may give the robot a scale the tables do not know
+// ("robot_scale_ppm" about "robot_scale_about_mm", the monitor's scenario):
+// the sensor and the parts are then off by s (p - about) more.
 // Exit 0 when every place equals the C++ correction within kSameMm and lands
 // within its region's tolerance; 1 otherwise (2: usage or unreadable input).
 //
@@ -169,8 +172,24 @@ std::vector<const Target*> PlacesInOrder(const CompileState& state) {
 struct TripLatency {
   double smallest = 0, largest = 0;
 };
+// The robot's scale the tables do not know, this cycle: s and the point it is about.
+struct RobotScale {
+  double s = 0;
+  Eigen::Vector2d about = Eigen::Vector2d::Zero();
+  Eigen::Vector2d Off(const Eigen::Vector2d& command) const { return s * (command - about); }
+};
+
+RobotScale ScaleOf(const json& cycle) {
+  RobotScale scale;
+  scale.s = cycle.value("robot_scale_ppm", 0.0) * 1e-6;
+  if (cycle.contains("robot_scale_about_mm")) {
+    scale.about = {cycle["robot_scale_about_mm"][0].get<double>(), cycle["robot_scale_about_mm"][1].get<double>()};
+  }
+  return scale;
+}
+
 TripLatency CheckTrips(const cell::Fixture& fixture, const std::vector<SensorModel>& sensor, const json& trips,
-                       const Eigen::Affine3d& truth) {
+                       const Eigen::Affine3d& truth, const RobotScale& scale) {
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const double nominal_angle = FixAngleRad(NominalFix(fixture));
   const double turn = nominal_angle - FixAngleRad(truth);  // legs run at the nominal pose
@@ -184,7 +203,7 @@ TripLatency CheckTrips(const cell::Fixture& fixture, const std::vector<SensorMod
       continue;
     }
     const Eigen::Vector2d base(trips[key][0].get<double>(), trips[key][1].get<double>());
-    const Eigen::Vector2d f = ToFixtureFrame(truth, sensor[expected[k].path](base));  // where the sensor was
+    const Eigen::Vector2d f = ToFixtureFrame(truth, sensor[expected[k].path](base) + scale.Off(base));  // where the sensor was
     const EdgeLine edge = EdgeLineOf(fixture.edges[static_cast<std::size_t>(expected[k].edge)]);
     const Eigen::Vector2d travel = to_true * expected[k].leg_direction;
     const double past = (edge.normal.dot(f) - edge.offset) / edge.normal.dot(travel);
@@ -225,7 +244,8 @@ int Run(const Options& options) {
     std::cout << fmt::format("cycle {}: board at x {:.4f} y {:.4f} angle {:.4f} deg{}\n", cycle_number,
                              FixOrigin(truth).x(), FixOrigin(truth).y(), FixAngleRad(truth) * kDegPerRad,
                              cycle["pose"].value("present", true) ? "" : " (no board)");
-    const TripLatency past = CheckTrips(fixture, sensor, cycle["trips"], truth);
+    const RobotScale scale = ScaleOf(cycle);
+    const TripLatency past = CheckTrips(fixture, sensor, cycle["trips"], truth, scale);
     const json scan = ReadJson(cycle["scan"].get<std::string>());
     const double speed = fixture.TripLatchSpeedMmS();  // the feed that latches the trips
     // The sensor HAL's affine model of the tables is that far off at most.
@@ -284,7 +304,7 @@ int Run(const Options& options) {
       const double same = (command - solution.point).norm();
       const double du = std::abs(at[5].get<double>() - required[3]);
       // Where the part lands: the command through the cell's tables, in the board's true frame.
-      const Eigen::Vector2d reached = DirectCalibrateInCell(cell.regions, command);
+      const Eigen::Vector2d reached = DirectCalibrateInCell(cell.regions, command) + scale.Off(command);
       const double landing = (ToFixtureFrame(truth, reached) - Xy(target.in_frame)).norm();
       worst_same = std::max(worst_same, same);
       worst_u = std::max(worst_u, du);

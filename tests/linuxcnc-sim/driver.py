@@ -67,13 +67,18 @@ def place_board(pose, sensor_models):
     """The board's true pose for the sensor HAL (marker-sensor.hal): per
     marker k (the models in marker order), f = R(a)^T (M p + b - o) into
     sum2.(2k) and sum2.(2k+1), where M p + b is where the robot really puts
-    the sensor for a command p around that marker."""
+    the sensor for a command p around that marker. A robot whose scale the
+    tables do not know (robot_scale_ppm about robot_scale_about_mm, the
+    monitor's scenario) puts it s (p - about) farther: M + s I, b - s about."""
     a = math.radians(pose["angle_deg"])
     c, s = math.cos(a), math.sin(a)
     o = (pose["x_mm"], pose["y_mm"])
+    scale = pose.get("robot_scale_ppm", 0.0) * 1e-6
+    about = pose.get("robot_scale_about_mm", [0.0, 0.0])
     commands = [f"sets board-present {'true' if pose.get('present', True) else 'false'}"]
     for k, model in enumerate(sensor_models):
-        m, b = model["m"], model["b"]
+        m = [[model["m"][0][0] + scale, model["m"][0][1]], [model["m"][1][0], model["m"][1][1] + scale]]
+        b = [model["b"][0] - scale * about[0], model["b"][1] - scale * about[1]]
         rt = ((c, s), (-s, c))  # R(a)^T
         for row in range(2):
             g0 = rt[row][0] * m[0][0] + rt[row][1] * m[1][0]

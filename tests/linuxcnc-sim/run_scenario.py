@@ -25,6 +25,9 @@
 # 6. A refused scan: the abort names the fixture, the same check and value
 #    as `smtcal fixture`, and the vacuum valve did not change after the scan
 #    began.
+# 7. The cycle record the runtime wrote (docs/monitor.md): one record per
+#    scan, refused ones too, each what `smtcal fixture` made of the latched
+#    trips; the monitor scenarios then run `smtcal monitor` on it.
 #
 # Exit 0: passed; 1: failed; 77: skipped (LinuxCNC or namespaces cannot
 # start here; the message says why).
@@ -33,6 +36,7 @@ import hashlib
 import json
 import math
 import os
+import random
 import re
 import shutil
 import subprocess
@@ -133,6 +137,44 @@ SCENARIOS = {
                       + [{"name": "one-stage-12", "what": "one stage at 12 mm/s",
                           "cell": {"scan_speed_mm_s": 12, "latch_speed_mm_s": None}}]},
 }
+# The monitor (docs/monitor.md): a board that walks and a robot whose scale
+# between the markers drifts (the sensor HAL's gains; the checker lands the
+# parts with it), both from cycle `start` on, with a little jitter of the
+# board's pose. The log must show both drifts, named, and the alarms must
+# come before the cycle at which the drifting scale would put parts at the
+# board's far corner out of tolerance. The short one runs with every ctest;
+# the long one is opt-in.
+MONITOR = os.path.join(HERE, "monitor.place")
+
+
+def drifting(cycles, start, walk_mm, scale_ppm, seed=30):
+    rng = random.Random(seed)
+    plan = []
+    for c in range(1, cycles + 1):
+        steps = max(0, c - start)
+        p = pose(rng.uniform(-0.01, 0.01) + steps * walk_mm, rng.uniform(-0.01, 0.01), rng.uniform(-0.003, 0.003))
+        p["robot_scale_ppm"] = steps * scale_ppm
+        p["robot_scale_about_mm"] = [0.0, 0.0]
+        plan.append(p)
+    return plan
+
+
+MONITOR_CELL = {"record_clock_pin": '"smtcal-clock.out"'}
+SCENARIOS["monitor_drift"] = {"program": MONITOR, "expect": "ok", "cell_add": MONITOR_CELL,
+                              "monitor": {"baseline": 6, "start": 6, "walk_mm": 0.02, "scale_ppm": 25},
+                              "cycles": drifting(13, 6, 0.02, 25)}
+SCENARIOS["monitor_drift_long"] = {"program": MONITOR, "expect": "ok", "cell_add": MONITOR_CELL,
+                                   "monitor": {"baseline": 20, "start": 25, "walk_mm": 0.005, "scale_ppm": 4},
+                                   "cycles": drifting(60, 25, 0.005, 4)}
+
+# Opt-in: what writing the record costs on the controller. No board: a
+# program of smtcal_data, the nominal trips written into fixture 0's
+# parameters, then loops of 200 calls each, timed with the clock HAL pin
+# (#<_hal[smtcal-clock.out]>, read when the interpreter gets there): an empty
+# loop, smtcal_record alone, smtcal_estimate (which writes its record too).
+SCENARIOS["record_overhead"] = {"program": SIM, "expect": "overhead", "cell_add": MONITOR_CELL, "cycles": [],
+                                "overhead_calls": 200}
+
 # Opt-in: the trip latency against the speed of one-stage probing (one good board each).
 for speed in (6, 12, 25, 50, 100):
     SCENARIOS[f"latency_{speed}mm_s"] = {"program": SIM, "expect": "ok",
@@ -201,6 +243,8 @@ def derive_ini(work, program_dir, dry_run, display="driver.py", extra_hals=("mar
             line = "SUBROUTINE_PATH = " + os.path.join(work, "runtime") + ":" + os.path.join(program_dir, "subroutines")
             if dry_run:
                 line = line.replace(" = ", " = " + os.path.join(program_dir, "dry-run") + ":")
+            # The cycle record's clock (#<_hal[smtcal-clock.out]>, marker-sensor.hal).
+            line += "\nHAL_PIN_VARS = 1"
         out.append(line)
         if section == "[HAL]" and key == "HALFILE":
             for hal in extra_hals:
@@ -377,6 +421,12 @@ def headless_example(args):
         fail(f"expected '{want}' from linuxcncrsh; got:\n{result.stdout[-2000:]}{result.stderr}\n{log_text}")
     log("paper-cell-headless.ini as shipped: linuxcncrsh homed the machine and ran layers.ngc; with no sensor "
         "wired the first scan aborted:\n  " + next(l for l in result.stdout.splitlines() if "marker scan" in l))
+    # The refused scan's record, written before the abort.
+    begins, records = read_record_log(os.path.join(work, RECORD_FILE))
+    if len(begins) != 1 or len(records) != 1 or records[0]["cycle"][1:5] != ["0", "1", "1", "1"] or \
+            [t[4:] for t in records[0]["trips"]] != [["-", "-"]] * 8:
+        fail(f"expected the record of one scan refused by missing_trip (all 8 trips missing), got {begins} {records}")
+    log("  its record: " + " ".join(records[0]["cycle"]) + " (before the abort)")
 
 
 def leftover_processes(marker):
@@ -502,8 +552,9 @@ def write_trips(path, trips):
 def cell_copy(work, scenario):
     """The cell a scenario runs: the example's, or a copy of it (and its
     tables, named relative to it) with its fixture replaced ("fixture": a
-    file holding a [[fixture]] section) and some keys changed ("cell")."""
-    if "cell" not in scenario and "fixture" not in scenario:
+    file holding a [[fixture]] section), some keys changed ("cell") and some
+    added to its last table ("cell_add")."""
+    if "cell" not in scenario and "fixture" not in scenario and "cell_add" not in scenario:
         return CELL
     text = open(CELL).read()
     if "fixture" in scenario:
@@ -519,6 +570,8 @@ def cell_copy(work, scenario):
             text, n = re.subn(r"(?m)^(scan_speed_mm_s = .*)$", rf"\1\n{key} = {value}", text)
         if n != 1:
             fail(f"cannot set {key} in a copy of the cell file")
+    for key, value in scenario.get("cell_add", {}).items():  # keys added to its last table ([linuxcnc])
+        text += f"{key} = {value}\n"
     cell_dir = os.path.join(work, "cell")
     os.makedirs(cell_dir)
     for name in os.listdir(os.path.dirname(CELL)):
@@ -602,6 +655,8 @@ def run_machine(args, scenario, work):
     sensor_models.sort(key=lambda m: m["marker"])  # the HAL's units: marker 1's, then marker 2's
     plan = {"program": os.path.join(program_dir, stem + ".ngc"), "cycles": scenario["cycles"],
             "sensor_models": sensor_models, "timeout_s": 120 + 100 * len(scenario["cycles"])}
+    if scenario["expect"] == "overhead":
+        plan["program"] = write_overhead_program(args, work, cell, scenario["overhead_calls"])
     plan_path = os.path.join(work, "plan.json")
     json.dump(plan, open(plan_path, "w"), indent=1)
     run_path = os.path.join(work, "run.json")
@@ -615,6 +670,9 @@ def run_machine(args, scenario, work):
     if scenario["expect"] == "dry_run_refused":
         check_dry_run_refused(record)
         return {"cycles": []}
+    if scenario["expect"] == "overhead":
+        report_overhead(record, work, scenario["overhead_calls"])
+        return {"cycles": []}
 
     # Per cycle: the latched trips, smtcal fixture's verdict on them.
     paths = trip_paths(args.smtcal, work)
@@ -626,6 +684,7 @@ def run_machine(args, scenario, work):
     previous = None
     verdicts = []
     check_cycles = []
+    latched = []
     for n, cycle in enumerate(record["cycles"]):
         observer = (f" (the driver's longest gap between two status polls in this cycle "
                     f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms: a probe result can show for as "
@@ -654,7 +713,10 @@ def run_machine(args, scenario, work):
             measured.append({"overhead_s": overhead, "pose_error_mm": error})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
-                             "scan": scan_json, "places": [e["position"] + [e["velocity"]] for e in places]})
+                             "scan": scan_json, "places": [e["position"] + [e["velocity"]] for e in places],
+                             "robot_scale_ppm": cycle["pose"].get("robot_scale_ppm", 0.0),
+                             "robot_scale_about_mm": cycle["pose"].get("robot_scale_about_mm", [0.0, 0.0])})
+        latched.append(trips)
     check_input = os.path.join(work, "check.json")
     json.dump({"cycles": check_cycles}, open(check_input, "w"), indent=1)
 
@@ -679,7 +741,161 @@ def run_machine(args, scenario, work):
             fail(f"{len(record['cycles'])} cycles ran of {len(scenario['cycles'])}")
     else:
         check_refusal(scenario, record, last, aborts)
+    check_record_log(os.path.join(work, RECORD_FILE), latched, verdicts, "monitor" in scenario)
+    if "monitor" in scenario:
+        check_monitor(args, scenario, cell, os.path.join(work, RECORD_FILE))
     return {"cycles": measured, "verify_scan_s": verify_scan_seconds(args, scenario["program"], cell)}
+
+
+# ------------------------------------------------------------------ the cycle record
+
+RECORD_FILE = "paper-cell-cycles.log"  # paper.cell.toml's [linuxcnc] record_file, in the folder LinuxCNC runs in
+CHECKS = ["missing_trip", "trip_window", "degenerate", "length_l1", "length_l2", "squareness", "line_residual",
+          "nominal_shift", "nominal_rotation", "cycle_shift", "cycle_rotation"]
+
+
+def read_record_log(path):
+    """The records of a log (docs/monitor.md), as lists of fields: a record
+    is its cycle line, its checks line and its trip lines."""
+    begins, records = [], []
+    for line in open(path):
+        fields = line.split()
+        if not fields:
+            continue
+        if fields[0] == "smtcal-record":
+            begins.append(fields)
+        elif fields[0] == "cycle":
+            records.append({"cycle": fields, "checks": None, "trips": []})
+        elif fields[0] == "checks" and records:
+            records[-1]["checks"] = fields
+        elif fields[0] == "trip" and records:
+            records[-1]["trips"].append(fields)
+        else:
+            fail(f"{path}: a line of no record: {line!r}")
+    return begins, records
+
+
+def check_record_log(path, latched, verdicts, clock):
+    """One record per scan, each what `smtcal fixture` made of the trips
+    LinuxCNC latched: the trips to 1e-9 mm (the runtime writes millionths
+    and e-6, since LinuxCNC prints a number below 1e-4 as 0), the verdict,
+    S1..S3 and every check's value (to the 6 decimals smtcal fixture --json
+    prints: a small value recorded as 0 would differ)."""
+    if not os.path.exists(path):
+        fail(f"the runtime wrote no cycle record ({path})")
+    begins, records = read_record_log(path)
+    if len(begins) != 1 or begins[0][1] != "2" or "fixtures=Board:8" not in begins[0]:
+        fail(f"expected one begin line of format 2 naming Board:8, got {begins}")
+    if len(records) != len(verdicts):
+        fail(f"{len(records)} records for {len(verdicts)} scans")
+    worst = 0.0
+    for n, (rec, verdict, trips) in enumerate(zip(records, verdicts, latched)):
+        c = rec["cycle"]
+        status = 0 if verdict["ok"] else CHECKS.index(verdict["fault"]) + 1
+        if c[1:4] != ["0", str(n + 1), str(status)] or rec["checks"] is None or len(rec["trips"]) != 8:
+            fail(f"record {n + 1}: {c} (want fixture 0, cycle {n + 1}, status {status}), {len(rec['trips'])} trips")
+        if (c[5] == "-") == clock:
+            fail(f"record {n + 1}: time {c[5]}, the clock {'was' if clock else 'was not'} configured")
+        for k, trip in enumerate(rec["trips"]):
+            if k not in trips:
+                if trip[4:] != ["-", "-"]:
+                    fail(f"record {n + 1}: T{k + 1} was not latched but is recorded at {trip[4:]}")
+                continue
+            worst = max(worst, abs(float(trip[4]) - trips[k]["x"]), abs(float(trip[5]) - trips[k]["y"]))
+        if verdict["s_mm"] is None:
+            if c[6:] != ["-"] * 6:
+                fail(f"record {n + 1}: S1..S3 {c[6:]} for a scan without a pose")
+        else:
+            got = [float(v) for v in c[6:]]
+            want = [v for s in verdict["s_mm"] for v in s]
+            if max(abs(a - b) for a, b in zip(got, want)) > 2e-6:  # smtcal fixture --json: 6 decimals
+                fail(f"record {n + 1}: S1..S3 {got}, smtcal fixture {want}")
+        for k, check in enumerate(verdict["checks"]):
+            value = rec["checks"][3 + k]
+            if not check["evaluated"]:
+                if value != "-":
+                    fail(f"record {n + 1}: check {check['name']} did not run but is recorded as {value}")
+            elif value == "-" or abs(float(value) - check["value"]) > 2e-6:
+                fail(f"record {n + 1}: check {check['name']} recorded {value}, smtcal fixture {check['value']}")
+    if worst > 1e-9:
+        fail(f"a recorded trip is {worst} mm from what LinuxCNC latched (the record keeps 1e-10)")
+    log(f"  cycle record: {len(records)} records, one per scan, each smtcal fixture's verdict and values; trips "
+        f"within {worst:.1e} mm of what LinuxCNC latched ({os.path.getsize(path)} bytes)")
+
+
+def check_monitor(args, scenario, cell, log_path):
+    """`smtcal monitor` on the run's log finds both drifts, names them, and
+    alarms before the drifting scale puts the far corner's parts out of
+    tolerance."""
+    m = scenario["monitor"]
+    result = smtcal(["monitor", log_path, "--cell", cell, "--baseline", str(m["baseline"]), "--json"], args.smtcal)
+    if result.returncode != 1:
+        fail(f"smtcal monitor: exit {result.returncode}, expected 1 (out of control)\n{result.stdout}{result.stderr}")
+    report = json.loads(result.stdout)
+    board = report["fixtures"][0]
+    findings = {f["kind"]: f for f in board["findings"]}
+    for kind in ("fixture_moving", "robot_scale"):
+        if kind not in findings:
+            fail(f"smtcal monitor did not find {kind}: {[f['kind'] for f in board['findings']]}")
+    corner = board["far_corner"]
+    margin_um = corner["tolerance_um"] - corner["budget_um"]
+    # The true scale error reaches the far corner's margin at this cycle.
+    true_out = m["start"] + margin_um / (corner["um_per_ppm"] * m["scale_ppm"])
+    scale = findings["robot_scale"]
+    walk = findings["fixture_moving"]
+    predicted = board["scans"] + scale["scans_to_limit"] if scale["scans_to_limit"] is not None else None
+    log(f"  smtcal monitor: out of control; fixture_moving alarm at scan {walk['alarm_scan']} (drift from cycle "
+        f"{m['start'] + 1}, began about scan {walk['change_scan']}); robot_scale alarm at scan "
+        f"{scale['alarm_scan']} (began about scan {scale['change_scan']}), far corner "
+        f"({corner['x_mm']}, {corner['y_mm']}) in {corner['region']}: {scale['now_um']} µm now of a "
+        f"{margin_um:.1f} µm margin, out of tolerance at scan {predicted and round(predicted, 1)} predicted, "
+        f"{true_out:.1f} true")
+    for line in scale["explanation"] + walk["explanation"]:
+        log("    " + line)
+    if scale["alarm_scan"] >= true_out:
+        fail(f"the robot_scale alarm (scan {scale['alarm_scan']}) came after the parts at the far corner left "
+             f"tolerance (scan {true_out:.1f})")
+    if predicted is None or predicted <= scale["alarm_scan"]:
+        fail(f"the predicted scan at which parts leave tolerance ({predicted}) is not after the alarm")
+
+
+def write_overhead_program(args, work, cell, calls):
+    """The timing program of record_overhead (SCENARIOS)."""
+    empty = os.path.join(work, "no-trips.csv")
+    open(empty, "w").write("name,x_mm,y_mm\n")
+    scan = json.loads(smtcal(["fixture", "--cell", cell, "--fixture", "Board", "--trips", empty, "--json"],
+                             args.smtcal).stdout)
+    lines = ["G21 G90 G17 G94", "o<smtcal_data> call", "#37 = 1 (a failed check is recorded, no abort)"]
+    for i, trip in enumerate(scan["trips"]):
+        x, y = trip["nominal_mm"]
+        lines += [f"#[#[#[#35 + 0] + 30] + {2 * i}] = {x!r}", f"#[#[#[#35 + 0] + 30] + {2 * i + 1}] = {y!r}",
+                  f"#[#[#[#35 + 0] + 31] + {i}] = 1"]
+    lines.append("o<smtcal_estimate> call [0]")
+    clock = "#<_hal[smtcal-clock.out]>"
+    for n, body in enumerate(["", "o<smtcal_record> call [0]", "o<smtcal_estimate> call [0]"]):
+        lines += [f"#<t{n}> = {clock}", "#<n> = 0", f"o{900 + n} while [#<n> LT {calls}]"]
+        if body:
+            lines.append("  " + body)
+        lines += ["  #<n> = [#<n> + 1]", f"o{900 + n} endwhile"]
+    lines += [f"#<t3> = {clock}",
+              "(DEBUG,overhead %.6f#<t0> %.6f#<t1> %.6f#<t2> %.6f#<t3>)", "M2"]
+    path = os.path.join(work, "overhead.ngc")
+    open(path, "w").write("\n".join(lines) + "\n")
+    return path
+
+
+def report_overhead(record, work, calls):
+    """The seconds each loop took, per call: the record alone, the scan's
+    estimate with its record."""
+    found = [m["text"] for m in record["messages"] if m["text"].startswith("overhead ")]
+    if not found:
+        fail(f"the timing program printed nothing; messages {record['messages']}")
+    t = [float(v) for v in found[0].split()[1:]]
+    loop, rec, estimate = ((t[k + 1] - t[k]) / calls for k in range(3))
+    lines = sum(1 for _ in open(os.path.join(work, RECORD_FILE)))
+    log(f"  per call on LinuxCNC's task (the clock's resolution is one servo period, 1 ms, over {calls} calls): "
+        f"empty loop {loop * 1e3:.3f} ms, smtcal_record {(rec - loop) * 1e3:.3f} ms, smtcal_estimate with its "
+        f"record {(estimate - loop) * 1e3:.3f} ms ({lines} lines logged)")
 
 
 def check_dry_run_refused(record):

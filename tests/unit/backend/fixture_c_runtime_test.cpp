@@ -109,15 +109,7 @@ RandomCase MakeCase(std::mt19937_64& rng) {
   }
   std::vector<Eigen::Vector2d> trips = test::SimulateTrips(fixture, truth, sensor, robot);
   c.trips = test::Present(trips);
-  const double fault = Uniform(rng, 0, 1);
-  const std::size_t k = std::uniform_int_distribution<std::size_t>(0, 7)(rng);
-  if (fault < 0.05) {
-    c.trips[k].reset();
-  } else if (fault < 0.10) {
-    *c.trips[k] += Eigen::Vector2d(Uniform(rng, -4, 4), Uniform(rng, -4, 4));
-  } else if (fault < 0.15) {
-    *c.trips[k] += Eigen::Vector2d(Uniform(rng, -0.3, 0.3), Uniform(rng, -0.3, 0.3));
-  }
+  test::InjectTripFault(c.trips, rng, 0.05);
   if (Uniform(rng, 0, 1) < 0.5) {
     c.previous = PlanarFix(FixOrigin(truth) + Eigen::Vector2d(Uniform(rng, -1.5, 1.5), Uniform(rng, -1.5, 1.5)),
                            FixAngleRad(truth) + Uniform(rng, -0.6, 0.6) * kRadPerDeg);

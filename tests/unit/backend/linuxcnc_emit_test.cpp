@@ -366,7 +366,11 @@ TEST(LinuxCncEmit, OutputDirectoryHoldsTheProgramTheRuntimeAndTheData) {
   ASSERT_EQ(review.exit_code, 0) << review.err;
   const std::string aborts = test::ReadFileText(dir / "out" / "subroutines" / "smtcal_scan_abort.ngc");
   EXPECT_NE(aborts.find("(abort,smtcal: marker scan of fixture Board failed check missing_trip: "), std::string::npos);
+  const std::string record = test::ReadFileText(dir / "out" / "subroutines" / "smtcal_record.ngc");
+  const std::string record_open = test::ReadFileText(dir / "out" / "subroutines" / "smtcal_record_open.ngc");
   EXPECT_EQ(review.out, "(smtcal file: layers.ngc)\n" + main + "(smtcal file: subroutines/smtcal_data.ngc)\n" + data +
+                            "(smtcal file: subroutines/smtcal_record.ngc)\n" + record +
+                            "(smtcal file: subroutines/smtcal_record_open.ngc)\n" + record_open +
                             "(smtcal file: subroutines/smtcal_scan_abort.ngc)\n" + aborts);
   fs::remove_all(dir);
 }

@@ -6,7 +6,11 @@
 // and prints FIX, every check's value, the verdict and the corrected
 // targets through (DEBUG, ...) with scaled values; a bad scan aborts before
 // the first placement; the example cell's data loads; a replacement
-// smtcal_probe_trips.ngc earlier on the subroutine path supplies trips.
+// smtcal_probe_trips.ngc earlier on the subroutine path supplies trips. The
+// cycle record every scan leaves (LOG lines, docs/monitor.md) is read back
+// with smtcal's reader and equals the C++ scan to 1e-10 mm or deg, small
+// values included (LinuxCNC prints a number below 1e-4 as 0: the record
+// writes millionths).
 #include <unistd.h>
 
 #include <cmath>
@@ -25,11 +29,14 @@
 
 #include "backend/linuxcnc/embedded_files.h"
 #include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
 #include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/diagnostics.h"
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
+#include "calibration/cycle_record.h"
 #include "frontend/cell_toml.h"
+#include "frontend/record_log.h"
 #include "tests/unit/backend/rs274_runner.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
@@ -50,6 +57,11 @@ using test::Uniform;
 // (the C runtime's test allows 1e-9 mm).
 constexpr double kAgreeMm = 1e-11;
 constexpr double kPrintScale = 1e6;
+// A cycle record's value against C++: the record prints millionths with 9
+// decimals, and LinuxCNC prints a number below 1e-4 as 0, so a value below
+// 1e-10 mm or deg reads as 0 (docs/monitor.md); rs274's arithmetic adds at
+// most kAgreeMm.
+constexpr double kRecordAgree = 1e-10 + kAgreeMm;
 
 const fs::path kPaperCell = fs::path(SMTCAL_SOURCE_DIR) / "examples" / "paper-cell" / "paper.cell.toml";
 
@@ -69,6 +81,8 @@ struct Workspace {
     }
     std::ofstream(sub / "smtcal_data.ngc", std::ios::binary) << EmitLinuxCncData(cell);
     std::ofstream(sub / "smtcal_scan_abort.ngc", std::ios::binary) << EmitLinuxCncScanAbort(cell);
+    std::ofstream(sub / "smtcal_record.ngc", std::ios::binary) << EmitLinuxCncRecord(cell);
+    std::ofstream(sub / "smtcal_record_open.ngc", std::ios::binary) << EmitLinuxCncRecordOpen(cell);
     std::vector<fs::path> path;
     if (with_override_dir) {
       fs::create_directories(dir / "first");
@@ -310,6 +324,23 @@ TEST(LinuxCncData, ExampleCellIsDeterministicAndSaysWhereItCameFrom) {
   EXPECT_GT(assignments, 1000);
 }
 
+// Every program of a cell shares its runtime folder (compile --ini), the
+// record's subroutines with it: they hold nothing of a program, and the
+// runtime id the main program checks covers them.
+TEST(LinuxCncData, RecordSubroutinesArePartOfTheSharedRuntime) {
+  std::string diagnostics;
+  std::optional<cell::Cell> cell = LoadPaperCell(&diagnostics);
+  ASSERT_TRUE(cell) << diagnostics;
+  ASSERT_TRUE(cell->linuxcnc && !cell->linuxcnc->record_file.empty());
+  EXPECT_EQ(EmitLinuxCncRecordOpen(*cell).find("program="), std::string::npos);
+  EXPECT_EQ(EmitLinuxCncRecord(*cell).find("program="), std::string::npos);
+  const long id = LinuxCncRuntimeId(*cell);
+  cell->linuxcnc->record_file = "other-" + cell->linuxcnc->record_file;
+  EXPECT_NE(LinuxCncRuntimeId(*cell), id) << "the record's log file is not in the runtime id";
+  cell->linuxcnc->record_file.clear();
+  EXPECT_NE(LinuxCncRuntimeId(*cell), id) << "a runtime without a record has the id of one with it";
+}
+
 TEST(LinuxCncData, RefusesWhatDoesNotFitTheParameters) {
   std::mt19937_64 rng(7);
   cell::Cell cell;
@@ -366,7 +397,19 @@ cell::Cell HarnessCell(std::mt19937_64& rng, cell::Estimator estimator) {
   decoy.origin_mm = fixture.origin_mm + Eigen::Vector2d(300, 0);
   cell.fixtures.push_back(decoy);
   cell.fixtures.push_back(fixture);
+  cell::LinuxCnc linuxcnc;
+  linuxcnc.record_file = "harness.log";  // rs274 prints the LOG lines instead
+  cell.linuxcnc = linuxcnc;
   return cell;
+}
+
+// The cycle records among rs274's canonical commands: LOG("line").
+std::string LoggedText(const test::Rs274Result& run) {
+  std::string text;
+  for (const std::string& line : run.canon) {
+    if (line.starts_with("LOG(\"") && line.ends_with("\")")) text += line.substr(5, line.size() - 7) + "\n";
+  }
+  return text;
 }
 
 // The harness's fixture in HarnessCell.
@@ -491,10 +534,48 @@ void RunHarness(std::mt19937_64& rng, cell::Estimator estimator, int cases, int 
   const test::Rs274Result run = ws.Run(program);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const Printed printed = ParseMessages(run.messages);
+  // Every scan's record, refused or not, read back as smtcal monitor reads it.
+  SourceManager sources;
+  Diagnostics diags(sources);
+  RecordLog log;
+  const std::string logged = LoggedText(run);
+  ASSERT_TRUE(ReadRecordLog(sources.Add("harness.log", logged), log, diags)) << diags.RenderText() << logged;
+  ASSERT_EQ(diags.warning_count(), 0u) << diags.RenderText();
+  ASSERT_EQ(log.begins.size(), 1u);
+  EXPECT_EQ(log.begins[0].begin.fixtures.size(), 2u);
+  ASSERT_EQ(log.cycles.size(), static_cast<std::size_t>(cases)) << logged;
 
   for (int i = 0; i < cases; ++i) {
     SCOPED_TRACE(fmt::format("case {} (fault {})", i, (first_fault + i) % kFaultCount));
     const ScanResult& cpp = expected[static_cast<std::size_t>(i)].scan;
+    {
+      // The record: what C++ makes of the same trips, to the record's resolution.
+      const CycleRecord want = RecordOfScan(kHarnessFixture, i + 1, std::nullopt, cpp);
+      const CycleRecord& got = log.cycles[static_cast<std::size_t>(i)].record;
+      EXPECT_EQ(got.fixture, want.fixture);
+      EXPECT_EQ(got.cycle, want.cycle);
+      EXPECT_EQ(got.status, want.status);
+      EXPECT_EQ(got.trip, want.trip);
+      EXPECT_FALSE(got.time_s);
+      ASSERT_EQ(got.trips.size(), want.trips.size());
+      for (std::size_t k = 0; k < want.trips.size(); ++k) {
+        ASSERT_EQ(got.trips[k].has_value(), want.trips[k].has_value()) << "T" << k + 1;
+        if (want.trips[k]) {
+          EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), kRecordAgree);
+        }
+      }
+      for (std::size_t c = 0; c < want.checks.size(); ++c) {
+        ASSERT_EQ(got.checks[c].has_value(), want.checks[c].has_value()) << "check " << c + 1;
+        if (want.checks[c]) {
+          EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), kRecordAgree)
+              << "check " << c + 1 << ": recorded " << *got.checks[c] << ", C++ " << *want.checks[c];
+        }
+      }
+      ASSERT_EQ(got.estimate.has_value(), want.estimate.has_value());
+      for (std::size_t k = 0; k < 3 && want.estimate; ++k) {
+        EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), kRecordAgree);
+      }
+    }
     ASSERT_EQ(printed.scans.count(i), 1u) << run.out;
     const Printed::Scan& s = printed.scans.at(i);
     const CheckResult* failure = cpp.FirstFailure();
@@ -819,6 +900,68 @@ TEST(LinuxCncRuntime, CorrectRefusesUnscannedFixturesAndOutsidePoints) {
   EXPECT_NE(outside.err.find("outside the table of region 0 whose outside policy is error"), std::string::npos)
       << outside.err;
   for (const std::string& line : outside.canon) EXPECT_NE(line, "SET_AUX_OUTPUT_BIT(8)");
+}
+
+// LinuxCNC prints a number below 1e-4 as 0 whatever its format: a scan
+// that is almost perfect (the board 2.3e-5 deg and some 3e-5 mm off
+// nominal, trips within 5e-5 mm, the previous pose as close) has check
+// values that small, and its record must keep them, not write 0.
+TEST(LinuxCncRuntime, CycleRecordKeepsValuesLinuxCncWouldPrintAsZero) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  std::mt19937_64 rng(seed);
+  cell::Cell cell = HarnessCell(rng, cell::Estimator::kRigid);
+  cell.regions.clear();  // no table: the trips are where the board is
+  const cell::Fixture& fixture = cell.fixtures[kHarnessFixture];
+  const Workspace ws("small", cell);
+  const Eigen::Affine3d truth = PlanarFix(fixture.origin_mm + Eigen::Vector2d(3e-5, -2e-5),
+                                          (fixture.angle_deg + 2.3e-5) * kRadPerDeg);
+  std::vector<double> sensor;
+  std::vector<Eigen::Vector2d> robot;
+  for (std::size_t k = 0; k < ExpectedTrips(fixture).size(); ++k) {
+    sensor.push_back(Uniform(rng, -5e-5, 5e-5));
+    robot.emplace_back(0, 0);
+  }
+  std::vector<Eigen::Vector2d> trips = test::SimulateTrips(fixture, truth, sensor, robot);
+  for (Eigen::Vector2d& t : trips) t -= DirectCalibrateInCell(cell.regions, t) - t;
+  const std::vector<std::optional<Eigen::Vector2d>> present = test::Present(trips);
+  const Eigen::Affine3d previous =
+      PlanarFix(FixOrigin(truth) + Eigen::Vector2d(4e-5, 1e-5), FixAngleRad(truth) + 1e-5 * kRadPerDeg);
+  ScanOptions options;
+  options.estimator = fixture.estimator;
+  options.regions = &cell.regions;
+  options.previous = previous;
+  const ScanResult cpp = ScanFixture(fixture, present, options);
+  ASSERT_EQ(cpp.FirstFailure(), nullptr);
+  const test::Rs274Result run = ws.Run(ProgramStart() + SetTrips(kHarnessFixture, present) +
+                                       SetPrevious(kHarnessFixture, previous) +
+                                       fmt::format("o<smtcal_estimate> call [{}]\n", kHarnessFixture) + ProgramEnd());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  SourceManager sources;
+  Diagnostics diags(sources);
+  RecordLog log;
+  const std::string logged = LoggedText(run);
+  ASSERT_TRUE(ReadRecordLog(sources.Add("small.log", logged), log, diags)) << diags.RenderText() << logged;
+  ASSERT_EQ(log.cycles.size(), 1u) << logged;
+  const CycleRecord want = RecordOfScan(kHarnessFixture, 1, std::nullopt, cpp);
+  const CycleRecord& got = log.cycles[0].record;
+  int small = 0;  // check values LinuxCNC alone would print as 0
+  for (std::size_t c = 0; c < want.checks.size(); ++c) {
+    ASSERT_TRUE(want.checks[c].has_value()) << "check " << c + 1;
+    ASSERT_TRUE(got.checks[c].has_value()) << "check " << c + 1;
+    EXPECT_LE(std::abs(*got.checks[c] - *want.checks[c]), kRecordAgree)
+        << "check " << c + 1 << ": recorded " << *got.checks[c] << ", C++ " << *want.checks[c] << "\n" << logged;
+    if (std::abs(*want.checks[c]) > 1e-9 && std::abs(*want.checks[c]) < 1e-4) ++small;
+  }
+  // nominal_rotation, cycle_shift, cycle_rotation and the line residuals at least.
+  EXPECT_GE(small, 4) << logged;
+  for (std::size_t k = 0; k < want.trips.size(); ++k) {
+    EXPECT_LE((*got.trips[k] - *want.trips[k]).cwiseAbs().maxCoeff(), kRecordAgree) << "T" << k + 1;
+  }
+  ASSERT_TRUE(got.estimate.has_value());
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_LE(((*got.estimate)[k] - (*want.estimate)[k]).cwiseAbs().maxCoeff(), kRecordAgree) << "S" << k + 1;
+  }
 }
 
 TEST(LinuxCncRuntime, HarnessAgreesWithCppOnRandomScansChecksAndPoints) {

@@ -177,4 +177,19 @@ inline cell::Region RegionOf(std::string name, ErrorTable table, double margin =
   return region;
 }
 
+// At most one fault in a random one of the trips, each kind with
+// probability `each`: the trip missing, far off (up to 4 mm), off (up to
+// 0.3 mm), so the scan's checks refuse some scans.
+inline void InjectTripFault(std::vector<std::optional<Eigen::Vector2d>>& trips, std::mt19937_64& rng, double each) {
+  const double fault = Uniform(rng, 0, 1);
+  const std::size_t k = std::uniform_int_distribution<std::size_t>(0, trips.size() - 1)(rng);
+  if (fault < each) {
+    trips[k].reset();
+  } else if (fault < 2 * each) {
+    *trips[k] += Eigen::Vector2d(Uniform(rng, -4, 4), Uniform(rng, -4, 4));
+  } else if (fault < 3 * each) {
+    *trips[k] += Eigen::Vector2d(Uniform(rng, -0.3, 0.3), Uniform(rng, -0.3, 0.3));
+  }
+}
+
 }  // namespace smtcal::test

@@ -141,6 +141,7 @@ std::map<std::string, std::string> BaseCommands(const fs::path& scratch) {
                                    Q(scratch / "plan.csv"))},
       {"measure program", fmt::format("measure program {} --cell {} -o {}", Q(kGolden / "measure-read/data/plan.csv"),
                                       Q(kGolden / "measure-read/data/cell.toml"), Q(scratch / "measure"))},
+      {"monitor", fmt::format("monitor {} --cell {}", Q(kGolden / "monitor/in_control.log"), cell)},
   };
 }
 

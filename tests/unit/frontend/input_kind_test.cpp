@@ -69,6 +69,9 @@ TEST(InputKind, CadListsAndTrips) {
             InputKind::kCadList);
   EXPECT_EQ(GuessInputKind("cpl.csv", "Designator,Mid X,Mid Y,Layer,Rotation\nR1,1,2,T,0\n"), InputKind::kCadList);
   EXPECT_EQ(GuessInputKind("trips.csv", "name,x_mm,y_mm,z_mm\nT1,1,2,-2\n"), InputKind::kTrips);
+  EXPECT_EQ(GuessInputKind("board.log", "smtcal-record 1 cell=c fixtures=B:8 clock=none segment=0\n"),
+            InputKind::kRecordLog);
+  EXPECT_NE(InputKindAdvice(InputKind::kRecordLog, "board.log").find("smtcal monitor board.log"), std::string::npos);
   EXPECT_EQ(GuessInputKind("feeders.toml", "[[feeder]]\nname = \"A\"\n"), InputKind::kFeeders);
   EXPECT_EQ(GuessInputKind("x.txt", "hello\n"), InputKind::kUnknown);
   EXPECT_EQ(GuessInputKind("x.place", ""), InputKind::kUnknown);

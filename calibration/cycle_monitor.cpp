@@ -1,0 +1,592 @@
+// What a log of cycle records says about the cell (calibration/cycle_monitor.h).
+#include "calibration/cycle_monitor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+#include "base/check.h"
+#include "base/field_text.h"
+#include "calibration/fixture_estimation.h"
+#include "calibration/fixture_geometry.h"
+#include "calibration/placement_budget.h"
+
+namespace smtcal {
+namespace {
+
+constexpr double kUmPerMm = 1000;
+constexpr double kPpm = 1e6;
+
+struct QuantityInfo {
+  std::string_view name, title, unit;
+  Direction direction;
+  double resolution;  // the chart's smallest sigma: what 6-decimal records resolve
+  bool gates;
+};
+
+constexpr std::array<QuantityInfo, kQuantities> kInfo = {{
+    {"pose_x", "board pose x", "µm", Direction::kBoth, 0.001, true},
+    {"pose_y", "board pose y", "µm", Direction::kBoth, 0.001, true},
+    {"pose_angle", "board angle", "mdeg", Direction::kBoth, 0.001, true},
+    {"marker_scale", "marker distance", "ppm", Direction::kBoth, 0.01, true},
+    {"sensor_threshold", "sensor threshold", "µm", Direction::kBoth, 0.001, true},
+    {"residual_rms", "trip scatter", "µm", Direction::kUp, 0.001, true},
+    {"residual_max", "largest residual", "µm", Direction::kUp, 0.001, false},
+}};
+
+const QuantityInfo& Info(Quantity q) { return kInfo[static_cast<std::size_t>(q)]; }
+
+// The scan's diagnostic fit: every trip on its edge line moved by the
+// sensor's threshold, the board turned, shifted and scaled. In the unknowns
+// u = (cos, sin) / scale, w (the shift) and delta (the threshold), a trip q
+// (base frame, centred) on the edge n . f = d of its marker gives the linear
+// equation  u1 (n . q) + u2 (n x q) - n . w - iota delta = d, iota = +1
+// when the marker lies on the normal's side of the edge (docs/monitor.md).
+class ScanDiagnostics {
+ public:
+  // The smallest singular value of the (column-normalised) design, relative
+  // to the largest, of a fit whose unknowns the layout determines.
+  static constexpr double kIdentifiable = 1e-6;
+  // The threshold's standard error in single trips' noise that still makes
+  // a chart: more, and it charts the trips' noise amplified.
+  static constexpr double kThresholdNoise = 2;
+
+  explicit ScanDiagnostics(const cell::Fixture& fixture) : expected_(ExpectedTrips(fixture)) {
+    std::vector<std::size_t> on_path(fixture.scan_paths.size(), 0);
+    for (const ExpectedTrip& e : expected_) {
+      const EdgeLine line = EdgeLineOf(fixture.edges[static_cast<std::size_t>(e.edge)]);
+      normals_.push_back(line.normal);
+      offsets_.push_back(line.offset);
+      // Every path starts off the markers: its trips enter and leave in turn.
+      const bool entering = on_path[e.path]++ % 2 == 0;
+      const double across = line.normal.dot(e.leg_direction) >= 0 ? 1.0 : -1.0;
+      iota_.push_back(entering ? across : -across);
+    }
+    // Which unknowns the layout determines, from the nominal trips: the
+    // scale when the design has full rank, the threshold when its standard
+    // error is at most kThresholdNoise times a single trip's (with the
+    // paper cell's layout each marker moves as a whole when the sensor sees
+    // it smaller, which the pose and the scale take: no threshold).
+    const std::vector<Eigen::Vector2d> nominal = NominalTrips(fixture, NominalFix(fixture));
+    scale_ = Rank(nominal, 4) == 4;
+    threshold_ = scale_ && Rank(nominal, 5) == 5 && ThresholdNoise(nominal) <= kThresholdNoise;
+  }
+
+  bool scale() const { return scale_; }
+  bool threshold() const { return threshold_; }
+
+  struct Fit {
+    double scale_ppm = 0;
+    std::optional<double> threshold_um;
+    double rms_um = 0;  // what the fit leaves
+  };
+
+  std::optional<Fit> Of(const std::vector<Eigen::Vector2d>& trips) const {
+    if (!scale_) return std::nullopt;
+    const int unknowns = threshold_ ? 5 : 4;
+    const Eigen::MatrixXd a = Design(trips, unknowns);
+    Eigen::VectorXd d(static_cast<Eigen::Index>(trips.size()));
+    for (std::size_t k = 0; k < trips.size(); ++k) d(static_cast<Eigen::Index>(k)) = offsets_[k];
+    const Eigen::VectorXd x = a.colPivHouseholderQr().solve(d);
+    const double length = std::hypot(x(0), x(1));
+    if (!std::isfinite(length) || length == 0) return std::nullopt;
+    Fit fit;
+    fit.scale_ppm = (1 / length - 1) * kPpm;
+    if (threshold_) fit.threshold_um = x(4) * kUmPerMm;
+    const Eigen::VectorXd r = a * x - d;
+    // Residuals in fixture millimetres: the equations are in fixture units.
+    fit.rms_um = std::sqrt(r.squaredNorm() / static_cast<double>(trips.size())) * kUmPerMm;
+    return fit;
+  }
+
+ private:
+  Eigen::MatrixXd Design(const std::vector<Eigen::Vector2d>& trips, int unknowns) const {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& t : trips) centre += t;
+    centre /= static_cast<double>(trips.size());
+    Eigen::MatrixXd a(static_cast<Eigen::Index>(trips.size()), unknowns);
+    for (std::size_t k = 0; k < trips.size(); ++k) {
+      const Eigen::Vector2d q = trips[k] - centre;
+      const Eigen::Vector2d& n = normals_[k];
+      const auto row = static_cast<Eigen::Index>(k);
+      a(row, 0) = n.dot(q);
+      a(row, 1) = n.x() * q.y() - n.y() * q.x();
+      a(row, 2) = -n.x();
+      a(row, 3) = -n.y();
+      if (unknowns == 5) a(row, 4) = -iota_[k];
+    }
+    return a;
+  }
+
+  // The threshold's standard error per unit of trip noise: sqrt of the last
+  // diagonal element of (A^T A)^-1.
+  double ThresholdNoise(const std::vector<Eigen::Vector2d>& trips) const {
+    const Eigen::MatrixXd a = Design(trips, 5);
+    const Eigen::MatrixXd inverse = (a.transpose() * a).inverse();
+    return std::sqrt(std::max(0.0, inverse(4, 4)));
+  }
+
+  int Rank(const std::vector<Eigen::Vector2d>& trips, int unknowns) const {
+    if (static_cast<int>(trips.size()) < unknowns) return 0;
+    Eigen::MatrixXd a = Design(trips, unknowns);
+    // Columns in comparable units: the rotation columns scale with the trips' spread.
+    for (Eigen::Index c = 0; c < a.cols(); ++c) {
+      const double norm = a.col(c).norm();
+      if (norm > 0) a.col(c) /= norm;
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a);
+    const Eigen::VectorXd s = svd.singularValues();
+    int rank = 0;
+    for (Eigen::Index i = 0; i < s.size(); ++i) rank += s(i) > kIdentifiable * s(0) ? 1 : 0;
+    return rank;
+  }
+
+  std::vector<ExpectedTrip> expected_;
+  std::vector<Eigen::Vector2d> normals_;
+  std::vector<double> offsets_;
+  std::vector<double> iota_;
+  bool scale_ = false, threshold_ = false;
+};
+
+// The placement error at a board point per ppm of robot scale error that
+// the tables do not know, through the fixture's estimator: the trips the
+// runtime calibrates are off by -s (t - c), the part lands off by s (r - c).
+double UmPerPpm(const cell::Fixture& fixture, const Eigen::Vector2d& in_fixture) {
+  constexpr double s = 1e-4;  // 100 ppm: linear, far above rounding
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, nominal);
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& t : trips) centre += t;
+  centre /= static_cast<double>(trips.size());
+  std::vector<Eigen::Vector2d> seen;
+  for (const Eigen::Vector2d& t : trips) seen.push_back(t - s * (t - centre));
+  const std::optional<FixEstimate> estimate = EstimateFix(fixture, ExpectedTrips(fixture), seen, fixture.estimator);
+  if (!estimate) return 0;
+  const Eigen::Vector2d required = ToBase(estimate->fix, in_fixture);
+  const Eigen::Vector2d landed = required + s * (required - centre);
+  return (landed - ToBase(nominal, in_fixture)).norm() * kUmPerMm / (s * kPpm);
+}
+
+Eigen::Vector2d TripCentre(const cell::Fixture& fixture) {
+  const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, NominalFix(fixture));
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& t : trips) centre += t;
+  return centre / static_cast<double>(trips.size());
+}
+
+// The point of a calibrated region on the board (fixture x in 0..L1, y in
+// 0..L2) where a scale error eats the margin first.
+std::optional<FarCorner> FindFarCorner(const cell::Cell& cell, const cell::Fixture& fixture) {
+  const FixtureErrorModel model(cell, fixture);
+  if (!model.defined()) return std::nullopt;
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  std::optional<FarCorner> worst;
+  double worst_room = std::numeric_limits<double>::infinity();
+  constexpr int kSamples = 5;  // per side of a region's bounds
+  // The regions that calibrate the scan's trips are the markers' own: no
+  // part is placed there.
+  const std::vector<int> trip_regions = TripRegions(fixture, cell.regions);
+  for (std::size_t r = 0; r < cell.regions.size(); ++r) {
+    const cell::Region& region = cell.regions[r];
+    if (std::find(trip_regions.begin(), trip_regions.end(), static_cast<int>(r)) != trip_regions.end()) continue;
+    for (int i = 0; i < kSamples; ++i) {
+      for (int j = 0; j < kSamples; ++j) {
+        const Eigen::Vector2d base(region.x_mm.lo + (region.x_mm.hi - region.x_mm.lo) * i / (kSamples - 1),
+                                   region.y_mm.lo + (region.y_mm.hi - region.y_mm.lo) * j / (kSamples - 1));
+        const Eigen::Vector2d f = ToFixtureFrame(nominal, base);
+        if (f.x() < 0 || f.x() > fixture.l1_mm || f.y() < 0 || f.y() > fixture.l2_mm) continue;
+        FarCorner corner;
+        corner.in_fixture = f;
+        corner.in_base = base;
+        corner.region = region.name;
+        corner.tolerance_mm = region.tolerance_mm;
+        const ErrorBudget budget = model.At(f, &region, 0);
+        if (!budget.bounded) continue;
+        corner.budget_mm = budget.BudgetMm();
+        corner.um_per_ppm = UmPerPpm(fixture, f);
+        // How many ppm it takes to use up the margin: the smallest wins.
+        const double room = corner.um_per_ppm > 0 ? corner.MarginMm() * kUmPerMm / corner.um_per_ppm
+                                                  : std::numeric_limits<double>::infinity();
+        if (!worst || room < worst_room ||
+            (room == worst_room && corner.um_per_ppm > worst->um_per_ppm)) {
+          worst = corner;
+          worst_room = room;
+        }
+      }
+    }
+  }
+  return worst;
+}
+
+// Scans until |now + per_scan t| reaches `limit` (all >= 0 but per_scan):
+// 0 when it is there, none when it does not approach.
+std::optional<double> ScansTo(double now, double per_scan, double limit) {
+  if (now >= limit) return 0.0;
+  if (per_scan <= 0) return std::nullopt;
+  return (limit - now) / per_scan;
+}
+
+// The same for a point moving with velocity v from p towards a circle of radius r.
+std::optional<double> ScansToCircle(const Eigen::Vector2d& p, const Eigen::Vector2d& v, double r) {
+  if (p.norm() >= r) return 0.0;
+  const double a = v.squaredNorm(), b = 2 * p.dot(v), c = p.squaredNorm() - r * r;
+  if (a == 0) return std::nullopt;
+  return (-b + std::sqrt(b * b - 4 * a * c)) / (2 * a);
+}
+
+std::optional<double> Median(std::vector<double> values) {
+  if (values.empty()) return std::nullopt;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+class FixtureAnalysis {
+ public:
+  FixtureAnalysis(const cell::Cell& cell, const cell::Fixture& fixture, const MonitorOptions& options)
+      : cell_(cell), fixture_(fixture), options_(options), diagnostics_(fixture), nominal_(NominalFix(fixture)) {}
+
+  FixtureMonitor Run(const std::vector<const CycleRecord*>& records) {
+    FixtureMonitor out;
+    out.name = fixture_.name;
+    out.fixture = &fixture_;
+    out.scans = static_cast<long>(records.size());
+    out.threshold_identifiable = diagnostics_.threshold();
+    for (std::size_t q = 0; q < kQuantities; ++q) {
+      out.series[q].quantity = static_cast<Quantity>(q);
+      out.series[q].gates = kInfo[q].gates;
+    }
+    Teach(out);
+    std::vector<double> gaps;
+    std::optional<Eigen::Affine3d> previous;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      const CycleRecord& record = *records[i];
+      const double scan = static_cast<double>(i + 1);
+      if (i > 0 && record.time_s && records[i - 1]->time_s && *record.time_s > *records[i - 1]->time_s) {
+        gaps.push_back(*record.time_s - *records[i - 1]->time_s);
+      }
+      if (record.cycle == 1) previous.reset();  // a new run: the runtime has no previous pose
+      const std::optional<Eigen::Affine3d> fix = Recompute(record, previous, static_cast<long>(i + 1), out);
+      if (!record.accepted() || !record.estimate) continue;
+      previous = fix;
+      ++out.accepted;
+      Measure(record, *fix, scan, out);
+    }
+    out.seconds_per_scan = Median(gaps);
+    Refusals(records, out);
+    out.far_corner = FindFarCorner(cell_, fixture_);
+    out.trip_centre = TripCentre(fixture_);
+    Chart(out);
+    return out;
+  }
+
+ private:
+  // The record's verdict and pose against the cell's, from its own trips.
+  std::optional<Eigen::Affine3d> Recompute(const CycleRecord& record, const std::optional<Eigen::Affine3d>& previous,
+                                           long scan, FixtureMonitor& out) {
+    std::optional<Eigen::Affine3d> fix;
+    if (record.estimate) fix = FixOfEstimate(*record.estimate, fixture_.l1_mm, fixture_.l2_mm);
+    if (record.trips.size() != ExpectedTrips(fixture_).size()) return fix;
+    ScanOptions scan_options;
+    scan_options.estimator = fixture_.estimator;
+    scan_options.regions = &cell_.regions;
+    scan_options.previous = previous;
+    const ScanResult result = ScanFixture(fixture_, record.trips, scan_options);
+    double difference = 0;
+    if (result.estimate.has_value() != record.estimate.has_value()) {
+      difference = std::numeric_limits<double>::infinity();
+    } else if (record.estimate) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        difference = std::max(difference, (result.estimate->s[k] - (*record.estimate)[k]).norm());
+      }
+    }
+    const CheckResult* failure = result.FirstFailure();
+    const int status = failure != nullptr ? static_cast<int>(failure->check) : 0;
+    // A cycle check needs the previous pose: a log that starts in the middle
+    // of a run does not have it, so those verdicts are not compared.
+    const bool cycle_check = record.status >= static_cast<int>(ScanCheck::kCycleShift) ||
+                             status >= static_cast<int>(ScanCheck::kCycleShift);
+    const bool comparable = previous.has_value() || record.cycle == 1 || !cycle_check;
+    bool verdict_differs = comparable && status != record.status;
+    if (verdict_differs && failure != nullptr && record.status != 0) {
+      // A value within rounding of its limit may tip either way.
+      const auto& value = record.checks[static_cast<std::size_t>(record.status) - 1];
+      const CheckResult& check = result.Check(static_cast<ScanCheck>(record.status));
+      verdict_differs = !(value && std::abs(*value - check.limit) < 10 * kRecordAgreementMm);
+    }
+    if (difference > kRecordAgreementMm || verdict_differs) {
+      if (out.disagreements == 0) out.first_disagreement_scan = scan;
+      ++out.disagreements;
+      if (std::isfinite(difference)) out.worst_disagreement_mm = std::max(out.worst_disagreement_mm, difference);
+    }
+    return fix;
+  }
+
+  void Add(FixtureMonitor& out, Quantity q, double scan, double value) {
+    SeriesResult& series = out.series[static_cast<std::size_t>(q)];
+    series.scan.push_back(scan);
+    series.values.push_back(value);
+  }
+
+  void Measure(const CycleRecord& record, const Eigen::Affine3d& fix, double scan, FixtureMonitor& out) {
+    const Eigen::Vector2d shift = (FixOrigin(fix) - fixture_.origin_mm) * kUmPerMm;
+    Add(out, Quantity::kPoseX, scan, shift.x());
+    Add(out, Quantity::kPoseY, scan, shift.y());
+    Add(out, Quantity::kPoseAngle, scan, RelativeAngleRad(nominal_, fix) * kDegPerRad * 1000);
+    if (const auto& worst = record.checks[static_cast<std::size_t>(ScanCheck::kLineResidual) - 1]) {
+      Add(out, Quantity::kResidualMax, scan, *worst * kUmPerMm);
+    }
+    std::vector<Eigen::Vector2d> calibrated;
+    for (const auto& trip : record.trips) {
+      if (!trip) return;
+      calibrated.push_back(DirectCalibrateInCell(cell_.regions, *trip));
+    }
+    if (const std::optional<ScanDiagnostics::Fit> fit = diagnostics_.Of(calibrated)) {
+      Add(out, Quantity::kMarkerScale, scan, fit->scale_ppm);
+      if (fit->threshold_um) Add(out, Quantity::kSensorThreshold, scan, *fit->threshold_um);
+      Add(out, Quantity::kResidualRms, scan, fit->rms_um);
+    }
+  }
+
+  void Teach(FixtureMonitor& out) {
+    if (fixture_.teach_trips_mm.empty() || fixture_.teach_trips_mm.size() != ExpectedTrips(fixture_).size()) return;
+    std::vector<Eigen::Vector2d> calibrated;
+    for (const Eigen::Vector2d& trip : fixture_.teach_trips_mm) calibrated.push_back(DirectCalibrateInCell(cell_.regions, trip));
+    if (const std::optional<ScanDiagnostics::Fit> fit = diagnostics_.Of(calibrated)) {
+      out.teach_scale_ppm = fit->scale_ppm;
+      out.teach_threshold_um = fit->threshold_um;
+    }
+  }
+
+  void Refusals(const std::vector<const CycleRecord*>& records, FixtureMonitor& out) {
+    const std::size_t baseline = std::min(options_.baseline, records.size());
+    for (ScanCheck check : kScanChecks) {
+      RefusalResult refusal;
+      refusal.check = check;
+      std::vector<bool> events;
+      for (std::size_t i = 0; i < records.size(); ++i) {
+        const bool refused = records[i]->failed() == check;
+        events.push_back(refused);
+        refusal.count += refused ? 1 : 0;
+        if (refused) refusal.at_scans.push_back(static_cast<long>(i + 1));
+        refusal.baseline_count += refused && i < baseline ? 1 : 0;
+      }
+      if (refusal.count == 0) continue;
+      // The in-control rate: the baseline's, pulled towards 1/2 by one
+      // refusal and one acceptance (Laplace), so a clean baseline does not
+      // make the first refusal an alarm.
+      refusal.p0 = (static_cast<double>(refusal.baseline_count) + 1) / (static_cast<double>(baseline) + 2);
+      const double p1 = std::min(0.9, 4 * refusal.p0);
+      if (p1 > refusal.p0) {
+        if (std::optional<std::size_t> alarm = BernoulliCusum(events, refusal.p0, p1, options_.refusal_h)) {
+          refusal.alarm_scan = static_cast<long>(*alarm + 1);
+        }
+      }
+      out.refusals.push_back(refusal);
+    }
+  }
+
+  void Chart(FixtureMonitor& out) {
+    out.charted = out.accepted >= static_cast<long>(std::max<std::size_t>(options_.baseline, 2)) + 1;
+    for (std::size_t q = 0; q < kQuantities; ++q) {
+      SeriesResult& series = out.series[q];
+      const auto kind = static_cast<Quantity>(q);
+      if (!series.values.empty()) {
+        const auto [limit_kind, limit] = LimitOf(kind);
+        out.process[q] = FiguresOf(series.values, options_.confidence, limit_kind, limit);
+      }
+      if (!out.charted || series.values.size() < std::max<std::size_t>(options_.baseline, 2) + 1) continue;
+      ChartOptions chart;
+      chart.baseline = options_.baseline;
+      chart.cusum_k = options_.cusum_k;
+      chart.cusum_h = options_.cusum_h;
+      chart.cusum_clip = options_.cusum_clip;
+      chart.ewma_lambda = options_.ewma_lambda;
+      chart.ewma_l = options_.ewma_l;
+      chart.direction = kInfo[q].direction;
+      chart.resolution = kInfo[q].resolution;
+      series.chart = RunChart(series.values, chart);
+      if (series.chart.alarm) {
+        series.trend = TrendFrom(series, series.scan[series.chart.change_point]);
+        if (kind != Quantity::kResidualRms && kind != Quantity::kResidualMax) {
+          series.shift_confirmed = ShiftConfirmed(series);
+        }
+      }
+    }
+    if (out.charted) Findings(out);
+  }
+
+  // The mean since the change point against the centre line, in standard
+  // errors of that mean (its values' own spread).
+  static bool ShiftConfirmed(const SeriesResult& series) {
+    const std::vector<double> after(series.values.begin() + static_cast<std::ptrdiff_t>(series.chart.change_point),
+                                    series.values.end());
+    if (after.size() < 2) return true;
+    double mean = 0;
+    for (double v : after) mean += v;
+    mean /= static_cast<double>(after.size());
+    double squares = 0;
+    for (double v : after) squares += (v - mean) * (v - mean);
+    const double se = std::sqrt(squares / static_cast<double>(after.size() - 1) / static_cast<double>(after.size()));
+    return se == 0 || std::abs(mean - series.chart.center) > kShiftConfirmed * se;
+  }
+
+  std::optional<Trend> TrendFrom(const SeriesResult& series, double from_scan) const {
+    std::vector<double> x, y;
+    for (std::size_t i = 0; i < series.values.size(); ++i) {
+      if (series.scan[i] < from_scan) continue;
+      x.push_back(series.scan[i]);
+      y.push_back(series.values[i]);
+    }
+    if (x.size() < 3) return std::nullopt;
+    return FitTrend(x, y);
+  }
+
+  // The limit each quantity's process figures are judged against.
+  std::pair<LimitKind, double> LimitOf(Quantity q) const {
+    switch (q) {
+      case Quantity::kPoseX:
+      case Quantity::kPoseY: return {LimitKind::kTwoSided, fixture_.max_shift_mm * kUmPerMm};
+      case Quantity::kPoseAngle: return {LimitKind::kTwoSided, fixture_.max_rotation_deg * 1000};
+      case Quantity::kMarkerScale:
+        return {LimitKind::kTwoSided, fixture_.length_tolerance_mm / std::max(fixture_.l1_mm, fixture_.l2_mm) * kPpm};
+      case Quantity::kResidualMax: return {LimitKind::kUpper, fixture_.max_line_residual_mm * kUmPerMm};
+      case Quantity::kSensorThreshold:
+      case Quantity::kResidualRms: return {LimitKind::kNone, 0};
+    }
+    return {LimitKind::kNone, 0};
+  }
+
+  const SeriesResult& Series(const FixtureMonitor& out, Quantity q) const {
+    return out.series[static_cast<std::size_t>(q)];
+  }
+
+  // The first alarm among some charts: the finding's skeleton, or nullopt.
+  std::optional<Finding> Alarmed(const FixtureMonitor& out, FindingKind kind, std::initializer_list<Quantity> charts) {
+    Finding finding;
+    finding.kind = kind;
+    bool any = false;
+    for (Quantity q : charts) {
+      const SeriesResult& series = Series(out, q);
+      if (!series.gates || !series.chart.alarm || !series.shift_confirmed) continue;
+      const auto alarm = static_cast<long>(series.scan[*series.chart.alarm]);
+      const auto change = static_cast<long>(series.scan[series.chart.change_point]);
+      finding.alarm_scan = any ? std::min(finding.alarm_scan, alarm) : alarm;
+      finding.change_scan = any ? std::min(finding.change_scan, change) : change;
+      finding.charts.push_back(q);
+      any = true;
+    }
+    if (!any) return std::nullopt;
+    return finding;
+  }
+
+  void Findings(FixtureMonitor& out) {
+    if (std::optional<Finding> f = Alarmed(out, FindingKind::kFixtureMoving,
+                                           {Quantity::kPoseX, Quantity::kPoseY, Quantity::kPoseAngle})) {
+      const std::optional<Trend> x = TrendFrom(Series(out, Quantity::kPoseX), static_cast<double>(f->change_scan));
+      const std::optional<Trend> y = TrendFrom(Series(out, Quantity::kPoseY), static_cast<double>(f->change_scan));
+      const std::optional<Trend> a =
+          TrendFrom(Series(out, Quantity::kPoseAngle), static_cast<double>(f->change_scan));
+      f->limit = fixture_.max_shift_mm * kUmPerMm;
+      if (x && y) {
+        const Eigen::Vector2d p(x->at_end, y->at_end), v(x->slope, y->slope);
+        f->now = p.norm();
+        f->per_scan = p.norm() > 0 ? p.dot(v) / p.norm() : v.norm();
+        f->scans_to_limit = ScansToCircle(p, v, f->limit);
+      }
+      if (a) {
+        const double limit = fixture_.max_rotation_deg * 1000;
+        const double toward = a->at_end >= 0 ? a->slope : -a->slope;
+        const std::optional<double> turn = ScansTo(std::abs(a->at_end), toward, limit);
+        if (turn && (!f->scans_to_limit || *turn < *f->scans_to_limit)) f->scans_to_limit = turn;
+      }
+      out.findings.push_back(*f);
+    }
+    if (std::optional<Finding> f = Alarmed(out, FindingKind::kRobotScale, {Quantity::kMarkerScale})) {
+      const std::optional<Trend> s = TrendFrom(Series(out, Quantity::kMarkerScale), static_cast<double>(f->change_scan));
+      if (s) {
+        const double scale_ppm = s->at_end;
+        const double toward = scale_ppm >= 0 ? s->slope : -s->slope;
+        if (out.far_corner && out.far_corner->um_per_ppm > 0) {
+          const FarCorner& corner = *out.far_corner;
+          f->now = std::abs(scale_ppm) * corner.um_per_ppm;
+          f->per_scan = toward * corner.um_per_ppm;
+          f->limit = corner.MarginMm() * kUmPerMm;
+          f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
+        }
+        f->stale = Stale(scale_ppm);
+      }
+      out.findings.push_back(*f);
+    }
+    if (std::optional<Finding> f =
+            Alarmed(out, FindingKind::kSensor, {Quantity::kSensorThreshold, Quantity::kResidualRms})) {
+      f->limit = fixture_.max_line_residual_mm * kUmPerMm;
+      if (const std::optional<Trend> r =
+              TrendFrom(Series(out, Quantity::kResidualMax), static_cast<double>(f->change_scan))) {
+        f->now = r->at_end;
+        f->per_scan = r->slope;
+        f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
+      }
+      out.findings.push_back(*f);
+    }
+    for (const RefusalResult& refusal : out.refusals) {
+      if (!refusal.alarm_scan) continue;
+      Finding f;
+      f.kind = FindingKind::kRefusals;
+      f.check = refusal.check;
+      f.alarm_scan = *refusal.alarm_scan;
+      out.findings.push_back(f);
+    }
+    out.in_control = out.findings.empty();
+  }
+
+  // The regions a scale error of `scale_ppm` moves beyond their tables'
+  // stated noise, relative to the markers the scan registers the board by.
+  std::vector<StaleRegion> Stale(double scale_ppm) const {
+    std::vector<StaleRegion> stale;
+    const Eigen::Vector2d centre = TripCentre(fixture_);
+    for (const cell::Region& region : cell_.regions) {
+      double far = 0;
+      for (double x : {region.x_mm.lo, region.x_mm.hi}) {
+        for (double y : {region.y_mm.lo, region.y_mm.hi}) far = std::max(far, (Eigen::Vector2d(x, y) - centre).norm());
+      }
+      StaleRegion r;
+      r.region = region.name;
+      r.drift_um = std::abs(scale_ppm) / kPpm * far * kUmPerMm;
+      r.noise_um = kBudgetSigmas * TableStandardErrorMm(region.table, cell_.robot.repeatability_mm).maxCoeff() * kUmPerMm;
+      if (r.drift_um > r.noise_um) stale.push_back(r);
+    }
+    return stale;
+  }
+
+  const cell::Cell& cell_;
+  const cell::Fixture& fixture_;
+  const MonitorOptions& options_;
+  ScanDiagnostics diagnostics_;
+  Eigen::Affine3d nominal_;
+};
+
+}  // namespace
+
+std::string_view QuantityName(Quantity quantity) { return Info(quantity).name; }
+std::string_view QuantityTitle(Quantity quantity) { return Info(quantity).title; }
+std::string_view QuantityUnit(Quantity quantity) { return Info(quantity).unit; }
+
+MonitorResult Monitor(const cell::Cell& cell, const std::vector<MonitoredCycle>& cycles,
+                      const MonitorOptions& options) {
+  MonitorResult result;
+  for (const cell::Fixture& fixture : cell.fixtures) {
+    std::vector<const CycleRecord*> records;
+    for (const MonitoredCycle& cycle : cycles) {
+      if (AsciiLowercase(cycle.fixture) == AsciiLowercase(RecordName(fixture.name))) records.push_back(&cycle.record);
+    }
+    if (records.empty()) continue;
+    FixtureAnalysis analysis(cell, fixture, options);
+    result.fixtures.push_back(analysis.Run(records));
+    result.in_control = result.in_control && result.fixtures.back().in_control;
+  }
+  return result;
+}
+
+}  // namespace smtcal
