@@ -270,16 +270,9 @@ void Run(const FixtureOptions& opt, GlobalOptions& options) {
   }
   SourceManager sources;
   Diagnostics diags(sources);
-  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
-  if (!loaded) {
-    options.exit_code = ReportIoError(loaded.error());
-    return;
-  }
-  if (!loaded.value()) {
-    options.exit_code = PrintDiagnostics(diags, options);
-    return;
-  }
-  const cell::Cell& cell = *loaded.value();
+  const std::optional<cell::Cell> loaded = LoadCellOrReport(opt.cell, sources, diags, options);
+  if (!loaded) return;
+  const cell::Cell& cell = *loaded;
   const cell::Fixture* fixture = cell.FindFixture(opt.fixture);
   if (fixture == nullptr) {
     std::string names;

@@ -66,16 +66,8 @@ void Run(const ScanReportOptions& opt, GlobalOptions& options) {
     }
     cell = &*compiled.cell;
   } else {
-    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
-    if (!loaded) {
-      options.exit_code = ReportIoError(loaded.error());
-      return;
-    }
-    if (!loaded.value()) {
-      options.exit_code = PrintDiagnostics(diags, options);
-      return;
-    }
-    loaded_cell = std::move(loaded).value();
+    loaded_cell = LoadCellOrReport(opt.cell, sources, diags, options);
+    if (!loaded_cell) return;
     cell = &*loaded_cell;
   }
   const cell::Fixture* fixture = opt.fixture.empty() && cell->fixtures.size() == 1 ? &cell->fixtures.front()

@@ -224,17 +224,8 @@ void RunDiff(const TableOptions& opt, GlobalOptions& options) {
   if (!new_table) return;
   std::optional<cell::Cell> cell;
   if (!opt.cell.empty()) {
-    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(opt.cell, sources, diags);
-    if (!loaded) {
-      PrintDiagnostics(diags, options);
-      options.exit_code = ReportIoError(loaded.error());
-      return;
-    }
-    if (!loaded.value()) {
-      options.exit_code = PrintDiagnostics(diags, options);
-      return;
-    }
-    cell = std::move(loaded).value();
+    cell = LoadCellOrReport(opt.cell, sources, diags, options);
+    if (!cell) return;
   }
   const TableChanges changes =
       CompareTables(*old_table, *new_table, opt.threshold_um, cell ? &cell->regions : nullptr);

@@ -56,6 +56,12 @@ int ReportIoError(const Error& error);               // kExitIoError
 int ReportUsageError(const std::string& message);    // kExitUsageError
 int ReportInputError(const std::string& message);    // kExitInputError: a mistake no diagnostic locates
 
+// The cell file at `path`, every table with it; or nullopt after printing
+// the diagnostics and, when the file could not be read, the I/O error
+// (options.exit_code set: kExitIoError, else kExitInputError).
+std::optional<cell::Cell> LoadCellOrReport(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                           GlobalOptions& options);
+
 // The files a command reads and writes, by the option that names them, for
 // CheckFiles: "-" is standard input (an input) or standard output (an
 // output); an output's `folder` says it is a folder (--target linuxcnc).

@@ -15,6 +15,7 @@
 
 #include "base/check.h"
 #include "base/field_text.h"
+#include "frontend/cell_toml.h"
 #include "tools/commands.h"
 
 namespace smtcal::tools {
@@ -108,6 +109,21 @@ std::string NoErrorsText(std::string_view name, std::size_t warnings) {
 int ReportIoError(const Error& error) {
   Say("IoError", "error", error.message);
   return kExitIoError;
+}
+
+std::optional<cell::Cell> LoadCellOrReport(const std::string& path, SourceManager& sources, Diagnostics& diags,
+                                           GlobalOptions& options) {
+  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, sources, diags);
+  if (!loaded) {
+    PrintDiagnostics(diags, options);
+    options.exit_code = ReportIoError(loaded.error());
+    return std::nullopt;
+  }
+  if (!loaded.value()) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return std::nullopt;
+  }
+  return std::move(loaded).value();
 }
 
 int ReportUsageError(const std::string& message) {

@@ -21,6 +21,7 @@
 #include "calibration/fixture_estimation.h"
 #include "frontend/record_log.h"
 #include "runtime/c/smtcal_record.h"
+#include "tests/unit/backend/c_object_symbols.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
 namespace smtcal {
@@ -249,18 +250,7 @@ TEST(CycleRecord, ObjectIsStrictC99WithNoHeapAndNoWritableGlobals) {
     ASSERT_EQ(built.exit_code, 0) << built.out;
     const Command symbols = RunShell("nm -P record.o", dir);
     ASSERT_EQ(symbols.exit_code, 0) << symbols.out;
-    std::istringstream lines(symbols.out);
-    std::string line;
-    while (std::getline(lines, line)) {
-      std::istringstream fields(line);
-      std::string name, type;
-      fields >> name >> type;
-      if (type == "U") {
-        EXPECT_TRUE(allowed.count(name)) << "the record calls " << name;
-      }
-      EXPECT_TRUE(type != "D" && type != "d" && type != "B" && type != "b" && type != "C")
-          << "writable global " << name << " (" << type << ")";
-    }
+    test::ExpectOnlyAllowedCallsAndNoWritableGlobals(symbols.out, allowed, "the record");
   }
   fs::remove_all(dir);
 }

@@ -22,6 +22,7 @@
 #include "calibration/fixture_estimation.h"
 #include "calibration/tolerances.h"
 #include "runtime/c/smtcal_runtime.h"
+#include "tests/unit/backend/c_object_symbols.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
 namespace smtcal {
@@ -400,20 +401,7 @@ TEST(FixtureCRuntime, ObjectHasNoHeapNoWritableGlobalsAndOnlySqrtAtan2FromLibm) 
     ASSERT_EQ(built.exit_code, 0) << built.out;
     const Command symbols = RunShell("nm -P runtime.o", dir);
     ASSERT_EQ(symbols.exit_code, 0) << symbols.out;
-    std::istringstream lines(symbols.out);
-    std::string line;
-    int defined_functions = 0;
-    while (std::getline(lines, line)) {
-      std::istringstream fields(line);
-      std::string name, type;
-      fields >> name >> type;
-      if (type == "U") {
-        EXPECT_TRUE(allowed.count(name)) << "the runtime calls " << name;
-      }
-      EXPECT_TRUE(type != "D" && type != "d" && type != "B" && type != "b" && type != "C")
-          << "writable global " << name << " (" << type << ")";
-      if (type == "T") ++defined_functions;
-    }
+    const int defined_functions = test::ExpectOnlyAllowedCallsAndNoWritableGlobals(symbols.out, allowed, "the runtime");
     EXPECT_GE(defined_functions, 10);
   }
   fs::remove_all(dir);
