@@ -52,8 +52,9 @@ struct MonitorOptions {
   double cusum_k = 0.5;       // sigmas
   double cusum_h = 10;        // sigmas
   double cusum_clip = 4;      // sigmas
-  // In-control alarms per chart, measured by simulation (docs/monitor.md):
-  // the guarded CUSUM about 1 in 10^7 scans, the EWMA 1 in 6 x 10^5.
+  // In-control alarms per chart with sigma and the centre known, by
+  // simulation (docs/monitor.md): the CUSUM about once in 79 000 scans, the
+  // EWMA once in 65 000; the guarded estimates of a baseline make each rarer.
   double ewma_lambda = 0.05;
   double ewma_l = 4.1;        // its sigmas
   double refusal_h = 10;      // the refusals' Bernoulli CUSUM: ln(20000)

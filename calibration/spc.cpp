@@ -259,10 +259,6 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     return count;
   };
   double c_up = 0, c_down = 0;
-  chart.cusum_up.resize(n);
-  chart.cusum_down.resize(n);
-  chart.ewma.resize(n);
-  chart.ewma_limit.resize(n);
   std::size_t last_zero_up = 0, last_zero_down = 0;
   bool zero_up_seen = false, zero_down_seen = false;
   const double lambda = options.ewma_lambda;
@@ -299,8 +295,6 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     const double clipped = std::clamp(z[i], -options.cusum_clip, options.cusum_clip);
     c_up = up ? std::max(0.0, c_up + clipped - k) : 0.0;
     c_down = down ? std::max(0.0, c_down - clipped - k) : 0.0;
-    chart.cusum_up[i] = c_up;
-    chart.cusum_down[i] = c_down;
     if (c_up > options.cusum_h) set(ChartRule::kCusumUp);
     if (c_down > options.cusum_h) set(ChartRule::kCusumDown);
     if (!chart.alarm && (c_up > options.cusum_h || c_down > options.cusum_h)) {
@@ -314,8 +308,6 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     ewma = lambda * clipped + (1 - lambda) * ewma;
     decay *= (1 - lambda) * (1 - lambda);
     const double limit = options.ewma_l * std::sqrt(lambda / (2 - lambda) * (1 - decay)) + centre_uncertainty;
-    chart.ewma[i] = ewma;
-    chart.ewma_limit[i] = limit;
     const bool ewma_up = up && ewma > limit, ewma_down = down && ewma < -limit;
     if (ewma_up) set(ChartRule::kEwmaUp);
     if (ewma_down) set(ChartRule::kEwmaDown);

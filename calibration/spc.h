@@ -110,8 +110,6 @@ struct ChartResult {
   double sigma = 0;           // the chart's: the estimate, guarded (ChartOptions::guard_estimates)
   double cusum_k = 0;         // the CUSUM's reference value in sigmas, guarded
   double mr_mean = 0;         // mean moving range of the baseline
-  std::vector<double> cusum_up, cusum_down;  // in sigmas, per value
-  std::vector<double> ewma, ewma_limit;      // in sigmas from the centre line, per value
   std::vector<RuleRun> runs;  // every run of every rule, in order of their first point
   // The first alarm of the CUSUM or the EWMA: where it crossed its limit,
   // the rule, the direction, and where the shift it signals most likely

@@ -350,9 +350,10 @@ def run_linuxcnc(work, ini, plan_path, run_path, timeout_s, **kwargs):
 # probe move the task can read motion's status from before the move was
 # queued, let the interpreter read on, and abort the program with this
 # error. Without a realtime kernel, where the servo thread can be preempted
-# mid-cycle, it comes about once in some thousands of probe moves here (the
-# example's scan makes 24 a cycle); it aborts the program before the cycle
-# places anything. A run it aborts says nothing about smtcal's program:
+# mid-cycle, it came here once in a run whose driver preempted the servo
+# thread (SCHED_FIFO), and not in 30 runs of limit_corners (5040 probe
+# moves) with the machine at nice -10 (tests/linuxcnc-sim/README.md); it
+# aborts the program during the scan, before the cycle places anything. A run it aborts says nothing about smtcal's program:
 # the scenario runs the machine again, at most twice, and says so.
 LINUXCNC_PROBE_RACE = "Queue is not empty after probing"
 LINUXCNC_PROBE_RACE_RUNS = 3
@@ -479,7 +480,7 @@ def trips_of_cycle(probes, paths, two_stage, path_points, observer=""):
     leaves a path at its first move that does not trip, so a move followed
     by another probe move on the same path (the nearest path's points: the
     markers are far apart) tripped whatever the flag read. `observer`: how
-    the driver polled (its priority, its longest gap), for a failure."""
+    the driver polled (its longest gap), for a failure."""
     def path_of(probe):
         return min(path_points, key=lambda name: min(math.dist((probe["x"], probe["y"]), point)
                                                      for point in path_points[name]))
@@ -686,9 +687,9 @@ def run_machine(args, scenario, work):
     check_cycles = []
     latched = []
     for n, cycle in enumerate(record["cycles"]):
-        observer = (f" (the driver's longest gap between two status polls in this cycle "
-                    f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms: a probe result can show for as "
-                    f"little as 15 ms)")
+        gap_ms = cycle.get("poll_gap_max_s", float("nan")) * 1000
+        observer = (f" (the driver's longest gap between two status polls in this cycle {gap_ms:.1f} ms: a probe "
+                    f"result can show for as little as 15 ms)")
         trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points, observer)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
@@ -708,8 +709,7 @@ def run_machine(args, scenario, work):
         if verdict["ok"]:
             error = pose_error(verdict, cycle["pose"])
             log(f"  cycle {n + 1}: scan overhead {overhead if overhead is None else round(overhead, 3)} s, "
-                f"board pose error {error:.4f} mm, driver's longest poll gap "
-                f"{cycle.get('poll_gap_max_s', float('nan')) * 1000:.1f} ms")
+                f"board pose error {error:.4f} mm, driver's longest poll gap {gap_ms:.1f} ms")
             measured.append({"overhead_s": overhead, "pose_error_mm": error})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
