@@ -126,20 +126,35 @@ std::string_view SeverityName(Severity severity) {
   return "error";
 }
 
-Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
-  if (limit_reached_) return nullptr;
-  message = Printed(message);
-  Severity severity = DiagKindSeverity(kind);
-  if (severity == Severity::Error && error_count_ >= error_limit_) {
-    limit_reached_ = true;
-    diagnostics_.push_back({DiagKind::TooManyErrors, Severity::Error, range,
-                            fmt::format("too many errors ({}); stopping here", error_count_), {}});
-    ++error_count_;
-    return nullptr;
+bool Diagnostics::Keeps(DiagKind kind) const {
+  if (limit_reached_) return false;
+  switch (DiagKindSeverity(kind)) {
+    case Severity::Error: return error_count_ < error_limit_;
+    case Severity::Warning: return warning_count_ < warning_limit_;
+    case Severity::Note: return true;
   }
-  if (severity == Severity::Warning && ++warning_count_ > warning_limit_) {
+  return true;
+}
+
+// Every diagnostic is counted, kept or not: a reader that asks whether its
+// part of the input had an error (error_count() before and after) gets the
+// truth after the limit too. Constant time per diagnostic.
+Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
+  Severity severity = DiagKindSeverity(kind);
+  if (severity == Severity::Error) {
+    if (error_count_ >= error_limit_) {
+      if (!limit_reached_) {
+        limit_reached_ = true;
+        diagnostics_.push_back({DiagKind::TooManyErrors, Severity::Error, range,
+                                fmt::format("too many errors ({}); stopping here", error_count_), {}});
+      }
+      ++error_count_;
+      return nullptr;
+    }
+    ++error_count_;
+  } else if (severity == Severity::Warning && ++warning_count_ > warning_limit_) {
     // Counted (the summaries say how many), but no longer shown.
-    if (warning_count_ == warning_limit_ + 1) {
+    if (warning_count_ == warning_limit_ + 1 && !limit_reached_) {
       diagnostics_.push_back({DiagKind::TooManyWarnings, Severity::Warning, range,
                               fmt::format("more than {} warnings; the others are counted but not shown",
                                           warning_limit_),
@@ -147,21 +162,9 @@ Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string messa
     }
     return nullptr;
   }
-  if (severity == Severity::Error) ++error_count_;
-  diagnostics_.push_back({kind, severity, range, std::move(message), {}});
+  if (limit_reached_) return nullptr;
+  diagnostics_.push_back({kind, severity, range, Printed(message), {}});
   return &diagnostics_.back();
-}
-
-std::size_t Diagnostics::Remove(DiagKind kind) {
-  const auto removed = std::remove_if(diagnostics_.begin(), diagnostics_.end(),
-                                      [kind](const Diagnostic& diag) { return diag.kind == kind; });
-  const std::size_t count = static_cast<std::size_t>(diagnostics_.end() - removed);
-  for (auto it = removed; it != diagnostics_.end(); ++it) {
-    if (it->severity == Severity::Error) --error_count_;
-    if (it->severity == Severity::Warning) --warning_count_;
-  }
-  diagnostics_.erase(removed, diagnostics_.end());
-  return count;
 }
 
 std::string Diagnostics::RenderText() const {

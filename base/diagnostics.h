@@ -52,8 +52,12 @@ class Diagnostics {
   explicit Diagnostics(const SourceManager& sources, std::size_t error_limit = 50, std::size_t warning_limit = 100)
       : sources_(sources), error_limit_(error_limit), warning_limit_(warning_limit) {}
 
+  // A diagnostic past the limits is counted without being formatted, so a
+  // loop that reports the same mistake a million times costs no more than
+  // counting it.
   template <typename... Args>
   Diagnostic* Report(DiagKind kind, SourceRange range, const Args&... args) {
+    if (!Keeps(kind)) return Add(kind, range, std::string());
     return Add(kind, range, fmt::vformat(DiagKindFormat(kind), fmt::make_format_args(args...)));
   }
   // Attaches a note to the diagnostic returned by Report (ignored if null:
@@ -61,11 +65,6 @@ class Diagnostics {
   // Messages and notes are made valid UTF-8 and cut after kMaxMessageBytes
   // (base/field_text.h), whatever they quote.
   static void AddNote(Diagnostic* diag, SourceRange range, std::string_view text);
-
-  // Takes back every diagnostic of `kind` (a command that reports the same
-  // finding its own way, e.g. simulate measuring what verify's budget
-  // predicts); returns how many there were.
-  std::size_t Remove(DiagKind kind);
 
   std::size_t error_count() const { return error_count_; }
   std::size_t warning_count() const { return warning_count_; }
@@ -83,6 +82,8 @@ class Diagnostics {
   std::string RenderJson() const;
 
  private:
+  // Whether a diagnostic of `kind` reported now would be kept (shown).
+  bool Keeps(DiagKind kind) const;
   Diagnostic* Add(DiagKind kind, SourceRange range, std::string message);
   static std::string Printed(std::string_view message);
 

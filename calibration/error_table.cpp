@@ -257,8 +257,8 @@ bool AddCheckPoints(AxisTable& table, TableAxis axis, const std::vector<TableNod
       diags.Report(DiagKind::TableCheckNearNode, check.x_field, FormatMm(check.x_mm), FormatMm(check.y_mm), name,
                    on ? "on" : "too near", FormatMm(table.xs[i]), FormatMm(table.ys[j]),
                    fmt::format("{:.0f}", 100 * place.CentreShare()), fmt::format("{:.0f}", 100 * kMinCheckPointShare),
-                   FormatMm(0.5 * (table.xs[place.i] + table.xs[place.i + 1])),
-                   FormatMm(0.5 * (table.ys[place.j] + table.ys[place.j + 1])));
+                   FormatComputedMm(0.5 * (table.xs[place.i] + table.xs[place.i + 1])),
+                   FormatComputedMm(0.5 * (table.ys[place.j] + table.ys[place.j + 1])));
       continue;
     }
     auto [it, inserted] = seen.emplace(std::make_pair(check.y_mm, check.x_mm), k);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -47,15 +48,14 @@ class TomlLocator {
   TomlLocator(const SourceManager& sources, std::uint32_t file) : sources_(sources), file_(file) {}
 
   // An unknown position (line 0) gives a location in the file without a line.
+  // Constant time per position: the byte offsets of a line's code points are
+  // found once per line (a line may hold 100 000 numbers of one array).
   SourceLoc At(const toml::source_position& position) const {
     if (position.line == 0) return SourceLoc{file_, 0, 0};
-    std::string_view line = sources_.File(file_).Line(position.line);
-    std::size_t byte = position.line == 1 && line.starts_with("\xEF\xBB\xBF") ? 3 : 0;
-    for (std::uint32_t code_point = 1; code_point < position.column && byte < line.size(); ++code_point) {
-      ++byte;
-      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
-    }
-    return SourceLoc{file_, position.line, static_cast<std::uint32_t>(byte + 1)};
+    if (position.line != indexed_line_) IndexLine(position.line);
+    const std::size_t code_point = position.column == 0 ? 0 : position.column - 1;
+    const std::uint32_t byte = code_point < starts_.size() ? starts_[code_point] : starts_.back();
+    return SourceLoc{file_, position.line, byte + 1};
   }
   // The region on its first line (a region over several lines: its start).
   SourceRange Range(const toml::source_region& region) const {
@@ -66,8 +66,25 @@ class TomlLocator {
   SourceRange Range(const toml::node& node) const { return Range(node.source()); }
 
  private:
+  // starts_[i]: the byte of code point i + 1 of line `line` (after a byte
+  // order mark on line 1); its last entry is the line's end.
+  void IndexLine(std::uint32_t line_number) const {
+    std::string_view line = sources_.File(file_).Line(line_number);
+    std::size_t byte = line_number == 1 && line.starts_with("\xEF\xBB\xBF") ? 3 : 0;
+    starts_.clear();
+    while (byte < line.size()) {
+      starts_.push_back(static_cast<std::uint32_t>(byte));
+      ++byte;
+      while (byte < line.size() && (static_cast<unsigned char>(line[byte]) & 0xc0) == 0x80) ++byte;
+    }
+    starts_.push_back(static_cast<std::uint32_t>(byte));
+    indexed_line_ = line_number;
+  }
+
   const SourceManager& sources_;
   std::uint32_t file_;
+  mutable std::uint32_t indexed_line_ = 0;
+  mutable std::vector<std::uint32_t> starts_;
 };
 
 }  // namespace smtcal

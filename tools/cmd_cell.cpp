@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/table_report.h"
 #include "backend/reports/cell_plot.h"
@@ -17,7 +18,7 @@
 #include "frontend/cell_toml.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
-#include "tools/compile_pipeline.h"
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -239,7 +240,7 @@ void RunPlot(const std::string& path, const std::string& output, const std::stri
     cell = std::move(loaded).value();
   } else {
     CompiledProgram compiled;
-    if (!CompileForCell(program_path, path, false, sources, diags, compiled, options)) return;
+    if (!CompileForCellOrReport(program_path, path, false, sources, diags, compiled, options)) return;
     cell = std::move(compiled.cell);
     if (compiled.program.compile != nullptr) {
       for (const Target& target : compiled.program.compile->targets) {

@@ -1,5 +1,6 @@
 // smtcal check FILE: parse a .place program and run the semantic checks.
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "frontend/parse.h"
 #include "passes/pass_manager.h"

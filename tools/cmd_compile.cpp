@@ -2,6 +2,7 @@
 // the checks and the correction passes; compile also emits the corrected
 // program, verify only reports.
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "base/json_text.h"
 #include "backend/c/c_data.h"
@@ -18,7 +19,7 @@
 #include "passes/correction/correction_passes.h"
 #include "passes/pass_manager.h"
 #include "tools/commands.h"
-#include "tools/compile_pipeline.h"
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -37,7 +38,7 @@ struct CompileOptions {
 
 
 ReportCounts Counts(const Diagnostics& diags) {
-  return {static_cast<int>(diags.error_count()), static_cast<int>(diags.warning_count())};
+  return {static_cast<int>(diags.error_count()), static_cast<int>(diags.warning_count()), diags.limit_reached()};
 }
 
 // The corrected program says at its top what it is.
@@ -71,7 +72,9 @@ void RunCompile(const CompileOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
-  if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
+  if (!CompileForCellOrReport(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) {
+    return;
+  }
   const CompileState& state = *compiled.program.compile;
   // The LinuxCNC emitter reports what it cannot lower with the passes'
   // diagnostics; it writes the main program as it goes (into the output
@@ -183,7 +186,9 @@ void RunVerify(const CompileOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
-  if (!CompileForCell(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) return;
+  if (!CompileForCellOrReport(opt.program_path, opt.cell_path, opt.verify_each, sources, diags, compiled, options)) {
+    return;
+  }
   options.exit_code = PrintDiagnostics(diags, options);
   const CompileState& state = *compiled.program.compile;
   std::string text = opt.json ? JsonText(CompileReportJson(compiled.program, state, sources, Counts(diags)))

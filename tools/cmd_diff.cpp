@@ -11,6 +11,7 @@
 
 #include <fmt/core.h>
 #include <fmt/ranges.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/diff/diff_cells.h"
 #include "backend/diff/diff_report.h"

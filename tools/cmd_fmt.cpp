@@ -1,6 +1,7 @@
 // smtcal fmt: print a .place program in canonical form (docs/language.md,
 // "Canonical form"). Only parses; the semantic checks are `smtcal check`.
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/place/place_printer.h"
 #include "frontend/parse.h"

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/place/place_printer.h"
 #include "backend/reports/import_report.h"

@@ -3,6 +3,8 @@
 // build` averages (docs/measure.md). The family only; each command is a file
 // of its own (cmd_measure_plan.cpp, cmd_measure_program.cpp,
 // cmd_measure_read.cpp).
+#include <CLI/CLI.hpp>
+
 #include "tools/commands.h"
 
 namespace smtcal::tools {

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/measurement_csv.h"
 #include "calibration/measurement_plan.h"

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/linuxcnc/linuxcnc_emit.h"
 #include "backend/linuxcnc/linuxcnc_measure.h"

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/measurement_csv.h"
 #include "base/field_text.h"

@@ -5,6 +5,7 @@
 // the reports backend/reports/monitor_report; this file wires files, options
 // and exit codes.
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/monitor_report.h"
 #include "base/field_text.h"

@@ -5,13 +5,14 @@
 // picture. The numbers are backend/reports/scan_report.h's; this file wires
 // the files, the options, the output and the exit codes.
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/scan_report.h"
 #include "calibration/fixture_geometry.h"
 #include "frontend/cell_toml.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
-#include "tools/compile_pipeline.h"
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -59,7 +60,7 @@ void Run(const ScanReportOptions& opt, GlobalOptions& options) {
   std::optional<cell::Cell> loaded_cell;
   const cell::Cell* cell = nullptr;
   if (!opt.program.empty()) {
-    if (!CompileForCell(opt.program, opt.cell, false, sources, diags, compiled, options)) return;
+    if (!CompileForCellOrReport(opt.program, opt.cell, false, sources, diags, compiled, options)) return;
     if (diags.has_errors()) {
       options.exit_code = PrintDiagnostics(diags, options);
       return;
@@ -69,6 +70,15 @@ void Run(const ScanReportOptions& opt, GlobalOptions& options) {
     loaded_cell = LoadCellOrReport(opt.cell, sources, diags, options);
     if (!loaded_cell) return;
     cell = &*loaded_cell;
+  }
+  if (cell->fixtures.empty()) {
+    // The cell is valid (`cell check` passes it); it has no scan to report.
+    options.exit_code = PrintDiagnostics(diags, options);
+    options.exit_code = ReportInputError(fmt::format(
+        "the cell {} describes no fixture, so it has no marker scan to report; a fixture board re-registered "
+        "every cycle is a [[fixture]] table of the cell file (docs/cell.md)",
+        opt.cell));
+    return;
   }
   const cell::Fixture* fixture = opt.fixture.empty() && cell->fixtures.size() == 1 ? &cell->fixtures.front()
                                                                                   : cell->FindFixture(opt.fixture);

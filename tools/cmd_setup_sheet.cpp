@@ -4,13 +4,14 @@
 // program goes through the same passes as `smtcal compile`; a program that
 // does not compile for the cell has no sheet.
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/setup_sheet.h"
 #include "frontend/feeders_toml.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
 #include "tools/feeders_option.h"
-#include "tools/compile_pipeline.h"
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -34,7 +35,7 @@ void RunSetupSheet(const SetupSheetOptions& opt, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
   CompiledProgram compiled;
-  if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  if (!CompileForCellOrReport(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
   cad::FeedersFile feeders_file;
   if (!LoadFeedersOption(opt.feeders, sources, diags, feeders_file, options)) return;
   std::optional<cad::FeederTable> feeders =

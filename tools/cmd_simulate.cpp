@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include <fmt/core.h>
+#include <CLI/CLI.hpp>
 
 #include "base/json_text.h"
 #include "backend/reports/compile_report.h"
@@ -26,7 +27,7 @@
 #include "simulation/virtual_cell.h"
 #include "ir/ir_ops.h"
 #include "tools/commands.h"
-#include "tools/compile_pipeline.h"
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -139,7 +140,7 @@ void RunSimulate(const SimulateOptions& opt, GlobalOptions& options) {
   // verify's verdicts on accuracy are what the simulation measures: they do
   // not stop it, the report says how many there were.
   compiled.report_budget_findings = false;
-  if (!CompileForCell(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
+  if (!CompileForCellOrReport(opt.program_path, opt.cell_path, false, sources, diags, compiled, options)) return;
   std::size_t over_budget = 0;
   for (const Target& target : compiled.program.compile->targets) {
     if (!target.known || target.region == nullptr || target.kind == CorrectionKind::kUncorrected) continue;

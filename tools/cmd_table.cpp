@@ -4,6 +4,7 @@
 // backend/table_*; this file only wires files, options and exit codes.
 #include <filesystem>
 #include <optional>
+#include <CLI/CLI.hpp>
 
 #include "backend/reports/table_diff_report.h"
 #include "backend/reports/table_plot.h"

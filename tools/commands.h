@@ -8,13 +8,18 @@
 #include <string_view>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "base/diagnostics.h"
 #include "base/number_range.h"
 #include "base/result.h"
 #include "calibration/cell.h"
 #include "frontend/measurement_input.h"
+
+// CLI11 is included only where options are defined (tools/cmd_*.cpp): its
+// header costs every file that includes it about 5 s of the build.
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace smtcal::tools {
 

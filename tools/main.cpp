@@ -12,6 +12,7 @@
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
+#include <CLI/CLI.hpp>
 
 #include "base/check.h"
 #include "base/field_text.h"

@@ -171,16 +171,17 @@ class Checker {
   void CheckTaskCycle() {
     const cell::Robot& robot = cell_.robot;
     const double most = MostTaskCycle(robot);
+    const std::string needs = fmt::format("{:.4g} or less (and more than 0)", most);
     const std::optional<double> cycle =
-        Value("TASK", "CYCLE_TIME", fmt::format("{:.4g} or less", most), "robot.probe_turnaround_s",
-              Num(robot.probe_turnaround_s));
-    if (!cycle || *cycle <= most * (1 + 1e-9)) return;
+        Value("TASK", "CYCLE_TIME", needs, "robot.probe_turnaround_s", Num(robot.probe_turnaround_s));
+    // The task's period: a time, so more than 0 (LinuxCNC would run its task
+    // loop without a pause, or not at all).
+    if (!cycle || (*cycle > 0 && *cycle <= most * (1 + 1e-9))) return;
     const IniEntry* entry = ini_.Find("TASK", "CYCLE_TIME");
     Diagnostic* diag = diags_.Report(
         DiagKind::LinuxCncMachineDisagrees, entry->range, "[TASK]CYCLE_TIME", entry->value,
         "robot.probe_turnaround_s", Num(robot.probe_turnaround_s),
-        fmt::format("CYCLE_TIME = {:.4g} or less (each probe move of the scan costs the task about three cycles)",
-                    most));
+        fmt::format("CYCLE_TIME = {} (each probe move of the scan costs the task about three cycles)", needs));
     Diagnostics::AddNote(diag, robot.range, "the scan's time (smtcal verify, smtcal scan report) assumes it");
   }
 

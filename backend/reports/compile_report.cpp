@@ -237,7 +237,8 @@ std::string VerifySummaryText(const ir::Program& program, const CompileState& st
   if (!state.trace_complete) text += "  the compile-time run stopped early: later targets were not verified\n";
   text += counts.errors == 0
               ? fmt::format("  verdict: ok{}\n", counts.warnings > 0 ? fmt::format(" ({} warning(s) above)", counts.warnings) : "")
-              : fmt::format("  verdict: {} problem(s), listed above; do not deploy\n", counts.errors);
+              : fmt::format("  verdict: {} problem(s), {}; do not deploy\n", counts.errors,
+                            counts.errors_cut ? "the first of them listed above" : "listed above");
   return text;
 }
 

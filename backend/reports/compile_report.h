@@ -19,6 +19,7 @@ namespace smtcal {
 struct ReportCounts {
   int errors = 0;
   int warnings = 0;
+  bool errors_cut = false;  // the error limit was reached: not every error is listed
 };
 
 // Every motion target (name, location, required and nominal position,

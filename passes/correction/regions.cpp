@@ -48,6 +48,7 @@ class Regions final : public Pass {
 
     // A base-frame statement is static only when it has one known position.
     const std::unordered_map<const ir::Stmt*, bool> as_written = BaseStatementsCommandedAsWritten(state.targets);
+    const std::string regions = RegionList(cell);  // the same in every message
     for (Target& target : state.targets) {
       std::string_view keyword = TargetKeyword(*target.stmt);
       SourceRange where = sema::StmtRange(*target.stmt);
@@ -65,11 +66,11 @@ class Regions final : public Pass {
       if (target.region != nullptr) continue;
       std::string x = FormatComputedMm(target.required[0]), y = FormatComputedMm(target.required[1]);
       if (std::holds_alternative<ir::PickPlace>(target.stmt->node)) {
-        diags.Report(DiagKind::TargetOutsideRegions, where, keyword, target.text, x, y, RegionList(cell));
+        diags.Report(DiagKind::TargetOutsideRegions, where, keyword, target.text, x, y, regions);
       } else {
         target.kind = CorrectionKind::kUncorrected;
         target.nominal = target.required;
-        diags.Report(DiagKind::TargetUncorrected, where, keyword, target.text, x, y, RegionList(cell));
+        diags.Report(DiagKind::TargetUncorrected, where, keyword, target.text, x, y, regions);
       }
     }
   }

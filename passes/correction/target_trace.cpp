@@ -11,7 +11,10 @@
 #include <optional>
 #include <set>
 #include <tuple>
+#include <type_traits>
 #include <unordered_map>
+#include <unordered_set>
+#include <variant>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -62,11 +65,9 @@ class Tracer {
   Tracer(const sema::SymbolTable& symbols, CompileState& state, Diagnostics& diags)
       : symbols_(symbols), state_(state), diags_(diags) {}
 
-  // Room for `statements` motion statements (so the map of them is not rehashed as it grows).
-  void Reserve(std::size_t statements) {
-    first_of_stmt_.reserve(statements);
-    next_of_stmt_.reserve(statements);
-  }
+  // Room for `statements` motion statements (so the map of their targets is
+  // not rehashed while most statements have one target).
+  void Reserve(std::size_t statements) { target_index_.reserve(statements); }
 
   void Run() {
     for (const sema::Symbol& symbol : symbols_.symbols()) {
@@ -300,28 +301,20 @@ class Tracer {
     if (trace_ != nullptr && !exploring_) trace_->push_back({TraceEvent::Kind::kMotion, index, 0});
   }
 
-  // Targets are unique per (statement, known, position). The targets of one
-  // statement are chained (most statements have one), so the lookup costs a
-  // hash of the statement and no node per target.
+  // Targets are unique per (statement, known, position), found by a hash
+  // of all three: a statement in a loop may reach any number of positions
+  // (a pallet's lanes), and each lookup stays constant time. The set holds
+  // indices into state_.targets (8 bytes a target, not a copy of its key).
   std::size_t FindOrAddTarget(Target target, const CallPath& call_path) {
-    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-    next_of_stmt_.resize(state_.targets.size(), kNone);
-    auto [first, inserted] = first_of_stmt_.emplace(target.stmt, state_.targets.size());
+    state_.targets.push_back(std::move(target));
+    auto [found, inserted] = target_index_.insert(state_.targets.size() - 1);
     if (!inserted) {
-      std::size_t i = first->second;
-      for (;;) {
-        const Target& seen = state_.targets[i];
-        if (seen.known == target.known && seen.in_frame == target.in_frame) return i;
-        if (next_of_stmt_[i] == kNone) break;
-        i = next_of_stmt_[i];
-      }
-      next_of_stmt_[i] = state_.targets.size();
+      state_.targets.pop_back();
+      return *found;
     }
     // Where it was reached first: the text made once per call.
     if (!call_path.shared) call_path.shared = state_.Share(call_path.Text());
-    target.call_path = *call_path.shared;
-    state_.targets.push_back(std::move(target));
-    next_of_stmt_.push_back(kNone);
+    state_.targets.back().call_path = *call_path.shared;
     return state_.targets.size() - 1;
   }
 
@@ -381,36 +374,56 @@ class Tracer {
     return flow;
   }
 
+  // Every statement kind is named: a kind added to the IR does not compile
+  // here until the trace says what it does (a motion must not vanish).
   Flow RunStmt(const ir::Stmt& stmt, Frame& frame) {
-    if (const auto* decl = std::get_if<ir::VarDecl>(&stmt.node)) {
-      for (const std::string& name : decl->names) frame.locals[sema::Lowercase(name)] = 0.0;
-    } else if (const auto* assign = std::get_if<ir::Assign>(&stmt.node)) {
-      Value value = Eval(assign->value.get(), frame);
-      if (Value* target = Lookup(assign->name, frame)) *target = value;
-    } else if (const auto* motion = std::get_if<ir::Motion>(&stmt.node)) {
-      RecordTarget(stmt, motion->target, frame);
-    } else if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) {
-      RecordTarget(stmt, pick->target, frame);
-    } else if (const auto* wait = std::get_if<ir::WaitTime>(&stmt.node)) {
-      Value seconds = Eval(wait->seconds.get(), frame);
-      if (trace_ != nullptr && !exploring_ && seconds) trace_->push_back({TraceEvent::Kind::kWait, 0, *seconds});
-    } else if (const auto* loop = std::get_if<ir::For>(&stmt.node)) {
-      return RunFor(*loop, frame);
-    } else if (const auto* branch = std::get_if<ir::If>(&stmt.node)) {
-      return RunIf(*branch, frame);
-    } else if (const auto* call = std::get_if<ir::Call>(&stmt.node)) {
-      const sema::Symbol* function = symbols_.Find(call->name);
-      if (function == nullptr || function->kind != sema::SymbolKind::Function) return Flow::kNext;
-      const CallPath path{frame.call_path, function->name};
-      Frame callee{&std::get<ir::Function>(function->decl->node), {}, &path};
-      Flow flow = RunBlock(callee.function->body, callee);
-      return flow == Flow::kStop ? Flow::kStop : Flow::kNext;
-    } else if (const auto* cycle = std::get_if<ir::Cycle>(&stmt.node)) {
-      return RunCycle(stmt, *cycle, frame);
-    } else if (std::holds_alternative<ir::ExitFunction>(stmt.node)) {
-      return Flow::kExitFunction;
-    }
-    return Flow::kNext;
+    return std::visit(
+        [&](const auto& node) -> Flow {
+          using Node = std::decay_t<decltype(node)>;
+          if constexpr (std::is_same_v<Node, ir::VarDecl>) {
+            for (const std::string& name : node.names) frame.locals[sema::Lowercase(name)] = 0.0;
+          } else if constexpr (std::is_same_v<Node, ir::Assign>) {
+            Value value = Eval(node.value.get(), frame);
+            if (Value* target = Lookup(node.name, frame)) *target = value;
+          } else if constexpr (std::is_same_v<Node, ir::Motion> || std::is_same_v<Node, ir::PickPlace>) {
+            RecordTarget(stmt, node.target, frame);
+          } else if constexpr (std::is_same_v<Node, ir::WaitTime>) {
+            Value seconds = Eval(node.seconds.get(), frame);
+            if (trace_ != nullptr && !exploring_ && seconds) trace_->push_back({TraceEvent::Kind::kWait, 0, *seconds});
+          } else if constexpr (std::is_same_v<Node, ir::For>) {
+            return RunFor(node, frame);
+          } else if constexpr (std::is_same_v<Node, ir::If>) {
+            return RunIf(node, frame);
+          } else if constexpr (std::is_same_v<Node, ir::Call>) {
+            const sema::Symbol* function = symbols_.Find(node.name);
+            if (function == nullptr || function->kind != sema::SymbolKind::Function) return Flow::kNext;
+            const CallPath path{frame.call_path, function->name};
+            Frame callee{&std::get<ir::Function>(function->decl->node), {}, &path};
+            Flow flow = RunBlock(callee.function->body, callee);
+            return flow == Flow::kStop ? Flow::kStop : Flow::kNext;
+          } else if constexpr (std::is_same_v<Node, ir::Cycle>) {
+            return RunCycle(stmt, node, frame);
+          } else if constexpr (std::is_same_v<Node, ir::ExitFunction>) {
+            return Flow::kExitFunction;
+          } else if constexpr (std::is_same_v<Node, ir::Comment> || std::is_same_v<Node, ir::ProgramDecl> ||
+                               std::is_same_v<Node, ir::UnitsDecl> || std::is_same_v<Node, ir::FixtureDecl> ||
+                               std::is_same_v<Node, ir::LocalDecl> || std::is_same_v<Node, ir::PointDecl> ||
+                               std::is_same_v<Node, ir::PalletDecl> || std::is_same_v<Node, ir::VacuumDecl> ||
+                               std::is_same_v<Node, ir::Function>) {
+            // Declarations: the symbol table holds what they say; a Function
+            // runs when it is called.
+          } else if constexpr (std::is_same_v<Node, ir::SetOutput> || std::is_same_v<Node, ir::WaitSwitch>) {
+            // I/O: no position, and no time the trace can know (a switch is
+            // waited for on the controller).
+          } else if constexpr (std::is_same_v<Node, ir::Scan>) {
+            // A scan moves the robot over the markers, not to a target; its
+            // time is the scan plan's (calibration/scan_plan.h).
+          } else {
+            static_assert(sizeof(Node) == 0, "statement kind the target trace does not handle");
+          }
+          return Flow::kNext;
+        },
+        stmt.node);
   }
 
   Flow RunCycle(const ir::Stmt& stmt, const ir::Cycle& cycle, Frame& frame) {
@@ -520,8 +533,26 @@ class Tracer {
   int depth_ = 0;  // blocks being run
   bool too_deep_ = false;
   Variables globals_;
-  std::unordered_map<const ir::Stmt*, std::size_t> first_of_stmt_;  // index into state_.targets
-  std::vector<std::size_t> next_of_stmt_;  // per target: the next target of its statement
+  // What makes a target: its statement, whether its position is known, and
+  // the position (compared as numbers: -0 is 0).
+  struct TargetHash {
+    const std::vector<Target>* targets;
+    std::size_t operator()(std::size_t index) const {
+      const Target& t = (*targets)[index];
+      std::size_t hash = std::hash<const ir::Stmt*>()(t.stmt) ^ (t.known ? 0x9e3779b97f4a7c15ull : 0);
+      for (double value : t.in_frame) hash = hash * 1099511628211ull ^ std::hash<double>()(value + 0.0);
+      return hash;
+    }
+  };
+  struct SameTarget {
+    const std::vector<Target>* targets;
+    bool operator()(std::size_t a, std::size_t b) const {
+      const Target &ta = (*targets)[a], &tb = (*targets)[b];
+      return ta.stmt == tb.stmt && ta.known == tb.known && ta.in_frame == tb.in_frame;
+    }
+  };
+  std::unordered_set<std::size_t, TargetHash, SameTarget> target_index_{
+      0, TargetHash{&state_.targets}, SameTarget{&state_.targets}};
   std::vector<TraceEvent>* trace_ = nullptr;
   bool exploring_ = false;  // in a branch the cycle trace does not follow
   long steps_ = 0;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Runs every smtcal command line of README.md, docs/*.md and
 examples/*/README.md, so the docs cannot drift from the program (CTest
-docs_commands; tests/docs/README.md says how to write docs for it).
+docs_<document>, one test per document; tests/docs/README.md says how to
+write docs for it).
 
     run_doc_commands.py --smtcal BUILD/smtcal --source REPO [-v] [--keep] [DOC.md ...]
 

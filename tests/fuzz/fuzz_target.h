@@ -1,7 +1,7 @@
 // One fuzz harness per reader or stage a user's file reaches (README.md in
 // this folder). A harness is written once with SMTCAL_FUZZ_TARGET(name) and
 // builds two ways:
-// - with SMTCAL_LIBFUZZER (the SMTCAL_FUZZ build, clang's libFuzzer): it is
+// - with SMTCAL_LIBFUZZER (the clang sanitizer build, libFuzzer): it is
 //   LLVMFuzzerTestOneInput of its own executable, smtcal_fuzz_<name>;
 // - otherwise it registers itself in smtcal_fuzz_replay, which the test
 //   suite runs over the seed corpus and every regression input, so each

@@ -41,6 +41,24 @@ for file in "$golden"/import-formats/* "$golden"/import-options/* "$golden"/impo
   case "$file" in *.out | *.err | *.args | *.exit | */ARGS | *.toml) continue ;; esac
   { printf '\x07'; cat "$file"; } > "$corpus/cad/$(basename "$(dirname "$file")")_$(basename "$file")"
 done
+# The machine harness reads an INI, then after a line %%HAL%% its HAL file,
+# as machine.ini and machine.hal: each INI of the golden machines and the
+# example, its #INCLUDE written in place and its HALFILE named machine.hal.
+mkdir -p "$corpus/linuxcnc_ini"
+for ini in "$golden"/linuxcnc/machines/*.ini examples/linuxcnc/paper-cell.ini; do
+  python3 - "$ini" "$corpus/linuxcnc_ini/$(basename "$(dirname "$ini")")_$(basename "$ini")" <<'PY'
+import os, re, sys
+ini, out = sys.argv[1], sys.argv[2]
+folder = os.path.dirname(ini)
+text = open(ini).read()
+text = re.sub(r"^#INCLUDE (\S+)$", lambda m: open(os.path.join(folder, m.group(1))).read(), text, flags=re.M)
+hal = re.search(r"^HALFILE = (\S+\.hal)$", text, flags=re.M)
+if hal and os.path.isfile(os.path.join(folder, hal.group(1))):
+    hal_text = open(os.path.join(folder, hal.group(1))).read()
+    text = text.replace(hal.group(0), "HALFILE = machine.hal") + "\n%%HAL%%\n" + hal_text
+open(out, "w").write(text)
+PY
+done
 # The loop that runs the compile-time trace to its 5 000 000-statement limit
 # takes 0.3 s in a release build but 10-90 s under the sanitizers on a busy
 # machine: every mutation of it would be a timeout. The golden suite keeps it.

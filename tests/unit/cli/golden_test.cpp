@@ -6,7 +6,8 @@
 // that the one it compares can go to standard output). Every other
 // file that is not *.out, *.err, *.args or ARGS is a case. The harness runs
 // smtcal in the suite folder and compares stdout with <case>.out and stderr
-// with <case>.err (a missing file means "expected empty"). A case named
+// with <case>.err (both always recorded, an empty output as an empty file; a
+// missing one fails the case). A case named
 // fail_* must exit 1; every other case must exit 0, unless <case>.exit holds
 // the exit code it must give (a gate such as `smtcal diff` exits 1 on clean
 // input). <case>.args overrides ARGS for one case.
@@ -44,13 +45,9 @@ void PrintTo(const GoldenCase& c, std::ostream* os) { *os << (c.suite / c.input)
 
 using smtcal::test::ReadFileText;
 
-void WriteOrRemove(const fs::path& path, const std::string& text) {
-  if (text.empty()) {
-    fs::remove(path);
-    return;
-  }
-  std::ofstream(path, std::ios::binary) << text;
-}
+// Both expectations are always recorded, an empty output as an empty file:
+// a case without them is not a case that expects nothing.
+void Write(const fs::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
 
 std::string Trim(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
@@ -146,9 +143,13 @@ TEST_P(GoldenFiles, MatchesExpectedOutput) {
   fs::path expected_err = stem.string() + ".err";
   const char* update = std::getenv("SMTCAL_UPDATE_GOLDEN");
   if (update != nullptr && std::string(update) == "1") {
-    WriteOrRemove(expected_out, run.out);
-    WriteOrRemove(expected_err, run.err);
+    Write(expected_out, run.out);
+    Write(expected_err, run.err);
     return;
+  }
+  for (const fs::path& expected : {expected_out, expected_err}) {
+    ASSERT_TRUE(fs::exists(expected)) << expected.string() << " is missing: record the case's expectations with "
+                                      << "SMTCAL_UPDATE_GOLDEN=1 (an empty output is an empty file)";
   }
   EXPECT_EQ(run.out, ReadFileText(expected_out)) << "stdout of: " << run.command;
   EXPECT_EQ(run.err, ReadFileText(expected_err)) << "stderr of: " << run.command;

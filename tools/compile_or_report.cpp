@@ -1,9 +1,9 @@
-// The front half of `smtcal compile` (tools/compile_pipeline.h).
-#include "tools/compile_pipeline.h"
+// The front half of `smtcal compile` (tools/compile_or_report.h).
+#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 
-bool CompileForCell(const std::string& program_path, const std::string& cell_path, bool verify_each,
+bool CompileForCellOrReport(const std::string& program_path, const std::string& cell_path, bool verify_each,
                     SourceManager& sources, Diagnostics& diags, CompiledProgram& out, GlobalOptions& options) {
   Result<std::uint32_t> file = sources.Load(program_path);
   if (!file) {

@@ -1,6 +1,7 @@
 // The front half of `smtcal compile` for the commands that need a program
-// corrected for a cell (compile, verify, simulate): passes/compile_pipeline.h
-// with the driver's printing and exit codes.
+// corrected for a cell (compile, verify, simulate, scan report, cell plot,
+// setup-sheet): passes/compile_pipeline.h's CompileForCell with the driver's
+// printing and exit codes, as LoadCellOrReport is the cell loader's.
 #pragma once
 
 #include <string>
@@ -16,7 +17,7 @@ namespace smtcal::tools {
 // everything printed and options.exit_code set, when the passes could not
 // run; true otherwise — the passes' own diagnostics are still in `diags`,
 // unprinted.
-bool CompileForCell(const std::string& program_path, const std::string& cell_path, bool verify_each,
+bool CompileForCellOrReport(const std::string& program_path, const std::string& cell_path, bool verify_each,
                     SourceManager& sources, Diagnostics& diags, CompiledProgram& out, GlobalOptions& options);
 
 }  // namespace smtcal::tools
