@@ -347,41 +347,37 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
   }
   std::vector<std::string> names;
   for (const FeederSpec& feeder : table.feeders_) names.push_back(feeder.name);
-  for (FeederRule& rule : file.rules) {
-    std::optional<std::size_t> feeder = find(rule.feeder);
+  // The feeder a [[map]] or a [[lane]] names, and its lane within the
+  // feeder's pick points; nullopt after reporting either.
+  auto resolve = [&](const std::string& name, SourceRange name_range, std::optional<int> lane,
+                     SourceRange lane_range) -> std::optional<std::size_t> {
+    std::optional<std::size_t> feeder = find(name);
     if (!feeder) {
-      std::string closest = ClosestName(rule.feeder, names);
-      diags.Report(DiagKind::FeedersUnknownFeeder, rule.feeder_range, Printable(rule.feeder),
+      std::string closest = ClosestName(name, names);
+      diags.Report(DiagKind::FeedersUnknownFeeder, name_range, Printable(name),
                    closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
-      continue;
+      return std::nullopt;
     }
     const FeederSpec& spec = table.feeders_[*feeder];
-    if (rule.lane && *rule.lane > spec.pick_points()) {
-      diags.Report(DiagKind::FeedersBadValue, rule.lane_range, "lane",
+    if (lane && *lane > spec.pick_points()) {
+      diags.Report(DiagKind::FeedersBadValue, lane_range, "lane",
                    fmt::format("a pick point of feeder '{}' (1 to {})", Printable(spec.name), spec.pick_points()),
-                   *rule.lane);
-      continue;
+                   *lane);
+      return std::nullopt;
     }
-    table.rule_feeder_.push_back(*feeder);
-    table.rules_.push_back(std::move(rule));
+    return feeder;
+  };
+  for (FeederRule& rule : file.rules) {
+    if (std::optional<std::size_t> feeder = resolve(rule.feeder, rule.feeder_range, rule.lane, rule.lane_range)) {
+      table.rule_feeder_.push_back(*feeder);
+      table.rules_.push_back(std::move(rule));
+    }
   }
   for (LaneNote& lane : file.lanes) {
-    std::optional<std::size_t> feeder = find(lane.feeder);
-    if (!feeder) {
-      std::string closest = ClosestName(lane.feeder, names);
-      diags.Report(DiagKind::FeedersUnknownFeeder, lane.feeder_range, Printable(lane.feeder),
-                   closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
-      continue;
+    if (std::optional<std::size_t> feeder = resolve(lane.feeder, lane.feeder_range, lane.lane, lane.lane_range)) {
+      table.lane_feeder_.push_back(*feeder);
+      table.lanes_.push_back(std::move(lane));
     }
-    const FeederSpec& spec = table.feeders_[*feeder];
-    if (lane.lane && *lane.lane > spec.pick_points()) {
-      diags.Report(DiagKind::FeedersBadValue, lane.lane_range, "lane",
-                   fmt::format("a pick point of feeder '{}' (1 to {})", Printable(spec.name), spec.pick_points()),
-                   *lane.lane);
-      continue;
-    }
-    table.lane_feeder_.push_back(*feeder);
-    table.lanes_.push_back(std::move(lane));
   }
   if (diags.error_count() != errors_before) return std::nullopt;
   return table;

@@ -179,11 +179,6 @@ class LabelPlacer {
   }
 
  private:
-  static std::size_t Utf8Columns(const std::string& text) {
-    std::size_t n = 0;
-    for (char c : text) n += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
-    return n;
-  }
   Rect area_;
   std::vector<Rect> taken_;
   std::vector<Label> labels_;
@@ -537,11 +532,6 @@ void DrawLegend(std::string& svg, double x, double y, bool program, bool finding
 // word longer than a line gets a line of its own), at most `max_lines` of
 // them, the last ending in "…" when words were left.
 std::vector<std::string> Wrapped(const std::string& text, std::size_t chars, std::size_t max_lines) {
-  auto columns = [](const std::string& s) {
-    std::size_t n = 0;
-    for (char c : s) n += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
-    return n;
-  };
   std::vector<std::string> lines(1);
   std::size_t start = 0;
   while (start < text.size()) {
@@ -549,7 +539,7 @@ std::vector<std::string> Wrapped(const std::string& text, std::size_t chars, std
     if (end == std::string::npos) end = text.size();
     const std::string word = text.substr(start, end - start);
     start = end + 1;
-    if (!lines.back().empty() && columns(lines.back()) + 1 + columns(word) > chars) {
+    if (!lines.back().empty() && Utf8Columns(lines.back()) + 1 + Utf8Columns(word) > chars) {
       if (lines.size() == max_lines) {
         lines.back() += " …";
         return lines;

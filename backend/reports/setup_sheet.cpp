@@ -288,11 +288,7 @@ std::string CsvField(const std::string& text) {
 }
 
 // Width of a text in columns: UTF-8 characters, not bytes (µ, Ω in values).
-std::size_t Columns(const std::string& text) {
-  std::size_t columns = 0;
-  for (char c : text) columns += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
-  return columns;
-}
+std::size_t Columns(const std::string& text) { return Utf8Columns(text); }
 
 std::string Padded(const std::string& text, std::size_t width) {
   return text + std::string(width > Columns(text) ? width - Columns(text) : 0, ' ');
@@ -548,7 +544,9 @@ std::string SetupSheetSvg(const SetupSheet& sheet) {
     used += chars[c] + 2;
   }
   const double tick = 28;  // the operator's tick box, last
-  const double table_width = kWidth - 2 * kMargin - tick;
+  // The text's room: the table less the tick box's column and a gap of two
+  // characters before it (the parts column's text runs up to its end).
+  const double table_width = kWidth - 2 * kMargin - tick - 2 * kChar;
   chars.back() = static_cast<std::size_t>(std::max(30.0, table_width / kChar - static_cast<double>(used) - 2));
   const double scale = std::min(1.0, table_width / (kChar * static_cast<double>(used + chars.back())));
   std::string heading = Heading(sheet);
