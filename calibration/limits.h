@@ -121,6 +121,10 @@ inline constexpr NumberRange kMonitorBaseline = Whole(2, 1'000'000);
 inline constexpr NumberRange kPaperToleranceMm = AboveZero(1, "mm");
 // import --vacuum: an output bit.
 inline constexpr NumberRange kVacuumOutput = Whole(kVacuumOutputMin, kVacuumOutputMax);
+// setup-sheet and import --boards: the boards of a lot (a count of parts
+// per slot stays exact in a double); --spares: percent of each slot's parts.
+inline constexpr NumberRange kLotBoards = Whole(1, 1e9);
+inline constexpr NumberRange kSparesPercent = Closed(0, 100, "%");
 // import --panel CxR: at most this many boards.
 inline constexpr long kMaxPanelBoards = 10'000;
 

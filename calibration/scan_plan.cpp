@@ -75,10 +75,17 @@ std::vector<Leg> LegsOf(const cell::Fixture& fixture) {
   return legs;
 }
 
+// What a failure concerns: a trip, or a leg (of scan_paths[path]) and the
+// edge it crosses besides its trips; -1 where none.
+struct Culprit {
+  int trip = -1, path = -1, leg = -1, edge = -1;
+};
+
 // The first condition a board at `pose` fails for some further shift within
 // `radius_mm` (S1 moved in the base frame), or "".
 std::string FirstFailure(const cell::Fixture& fixture, const std::vector<ExpectedTrip>& expected,
-                         const std::vector<Leg>& legs, const Eigen::Affine3d& pose, double radius_mm, int* trip) {
+                         const std::vector<Leg>& legs, const Eigen::Affine3d& pose, double radius_mm,
+                         Culprit* culprit) {
   const Eigen::Affine3d nominal = NominalFix(fixture);
   auto leg_of = [&](const ExpectedTrip& e) -> const Leg& {
     return *std::find_if(legs.begin(), legs.end(), [&](const Leg& l) { return l.path == e.path && l.index == e.leg; });
@@ -91,7 +98,7 @@ std::string FirstFailure(const cell::Fixture& fixture, const std::vector<Expecte
     std::optional<Crossing> c = CrossingOf(leg.from, leg.to, ToBase(pose, edge.from), ToBase(pose, edge.to));
     const std::optional<Crossing> at_nominal =
         CrossingOf(leg.from, leg.to, ToBase(nominal, edge.from), ToBase(nominal, edge.to));
-    *trip = static_cast<int>(k);
+    *culprit = Culprit{static_cast<int>(k)};
     if (!c || !at_nominal) return fmt::format("{} runs along edge {}", TripName(k), edge.name);
     const double leg_length = (leg.to - leg.from).norm(), edge_length = (edge.to - edge.from).norm();
     const double dt = radius_mm * c->gradient.row(0).norm(), du = radius_mm * c->gradient.row(1).norm();
@@ -118,7 +125,7 @@ std::string FirstFailure(const cell::Fixture& fixture, const std::vector<Expecte
     }
     crossings.push_back(c);
   }
-  *trip = -1;
+  *culprit = Culprit{};
   for (const Leg& leg : legs) {
     for (std::size_t e = 0; e < fixture.edges.size(); ++e) {
       const bool expected_here = std::any_of(expected.begin(), expected.end(), [&](const ExpectedTrip& t) {
@@ -128,6 +135,7 @@ std::string FirstFailure(const cell::Fixture& fixture, const std::vector<Expecte
       const cell::MarkerEdge& edge = fixture.edges[e];
       std::optional<Crossing> c = CrossingOf(leg.from, leg.to, ToBase(pose, edge.from), ToBase(pose, edge.to));
       if (c && DistanceToCrossingShifts(*c) <= radius_mm) {
+        *culprit = Culprit{-1, static_cast<int>(leg.path), static_cast<int>(leg.index), static_cast<int>(e)};
         return fmt::format("leg {} of scan path '{}' crosses edge {} besides its trips", leg.index + 1,
                            fixture.scan_paths[leg.path].name, edge.name);
       }
@@ -138,13 +146,13 @@ std::string FirstFailure(const cell::Fixture& fixture, const std::vector<Expecte
 
 // The first failure for any pose within k x the fixture's limits, or "".
 std::string FailureWithin(const cell::Fixture& fixture, const std::vector<ExpectedTrip>& expected,
-                          const std::vector<Leg>& legs, double k, int* trip) {
+                          const std::vector<Leg>& legs, double k, Culprit* culprit) {
   constexpr int kTurns = 20;  // even: the turn 0 is among the samples
   const double turn = k * fixture.max_rotation_deg * kRadPerDeg;
   for (int i = 0; i <= kTurns; ++i) {
     const double sample = turn * (2.0 * i / kTurns - 1);
     const Eigen::Affine3d pose = PlanarFix(fixture.origin_mm, fixture.angle_deg * kRadPerDeg + sample);
-    std::string why = FirstFailure(fixture, expected, legs, pose, k * fixture.max_shift_mm, trip);
+    std::string why = FirstFailure(fixture, expected, legs, pose, k * fixture.max_shift_mm, culprit);
     if (!why.empty()) return why;
   }
   return "";
@@ -175,8 +183,8 @@ bool ScanMeasuresPose(const cell::Fixture& fixture, const Eigen::Vector2d& shift
                       std::string* why) {
   const Eigen::Affine3d pose =
       PlanarFix(fixture.origin_mm + shift_mm, (fixture.angle_deg + turn_deg) * kRadPerDeg);
-  int trip = -1;
-  std::string failure = FirstFailure(fixture, ExpectedTrips(fixture), LegsOf(fixture), pose, 0, &trip);
+  Culprit culprit;
+  std::string failure = FirstFailure(fixture, ExpectedTrips(fixture), LegsOf(fixture), pose, 0, &culprit);
   if (why != nullptr) *why = failure;
   return failure.empty();
 }
@@ -185,32 +193,35 @@ CaptureRange ScanCaptureRange(const cell::Fixture& fixture) {
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const std::vector<Leg> legs = LegsOf(fixture);
   CaptureRange range;
-  int trip = -1;
-  std::string why = FailureWithin(fixture, expected, legs, kMaxCaptureFactor, &trip);
+  Culprit culprit;
+  std::string why = FailureWithin(fixture, expected, legs, kMaxCaptureFactor, &culprit);
   if (why.empty()) {
     range.factor = kMaxCaptureFactor;
   } else {
     double lo = 0, hi = kMaxCaptureFactor;
-    std::string at_zero = FailureWithin(fixture, expected, legs, 0, &trip);
+    std::string at_zero = FailureWithin(fixture, expected, legs, 0, &culprit);
     if (!at_zero.empty()) {
       why = at_zero;
     } else {
       for (int i = 0; i < 40; ++i) {
         const double mid = 0.5 * (lo + hi);
-        int mid_trip = -1;
-        std::string mid_why = FailureWithin(fixture, expected, legs, mid, &mid_trip);
+        Culprit mid_culprit;
+        std::string mid_why = FailureWithin(fixture, expected, legs, mid, &mid_culprit);
         if (mid_why.empty()) {
           lo = mid;
         } else {
           hi = mid;
           why = mid_why;
-          trip = mid_trip;
+          culprit = mid_culprit;
         }
       }
     }
     range.factor = lo;
     range.limited_by = why;
-    range.trip = trip;
+    range.trip = culprit.trip;
+    range.leg_path = culprit.path;
+    range.leg = culprit.leg;
+    range.edge = culprit.edge;
   }
   range.shift_mm = range.factor * fixture.max_shift_mm;
   range.rotation_deg = range.factor * fixture.max_rotation_deg;

@@ -49,6 +49,9 @@ struct CaptureRange {
   // and the trip it concerns (0-based) or -1.
   std::string limited_by;
   int trip = -1;
+  // When a leg crosses an edge besides its trips: the leg (0-based) of
+  // scan_paths[leg_path] and the edge (index into edges); else -1.
+  int leg_path = -1, leg = -1, edge = -1;
 };
 
 // The capture range of the fixture's scan paths as drawn. The fixture must

@@ -23,12 +23,14 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "base/check.h"
 #include "base/field_text.h"
 #include "base/sha256.h"
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
 #include "calibration/placement_budget.h"
+#include "calibration/region_fit.h"
 #include "calibration/scan_plan.h"
 #include "calibration/tolerances.h"
 #include "calibration/truth_spec.h"
@@ -186,6 +188,12 @@ class Loader {
   // cell.files: the cell file and its tables with their SHA-256.
   void RecordFiles(Cell& cell) const;
 
+  // Whether a part whose reading began at these counts is dropped: it had
+  // errors, and not only points outside the robot's travel with keep_drawable.
+  bool Dropped(std::size_t errors_before, std::size_t limit_errors_before) const {
+    const std::size_t errors = diags_.error_count() - errors_before;
+    return errors > 0 && !(options_.keep_drawable && errors == limit_errors_ - limit_errors_before);
+  }
   // Robot-limit checks; `robot_ok_` says whether [robot] was read cleanly.
   void CheckInLimit(int axis, double value, SourceRange where, const std::string& subject);
   void CheckPointInLimits(const std::array<double, 4>& point, SourceRange where, const std::string& subject);
@@ -199,6 +207,9 @@ class Loader {
   TomlLocator locator_;
   Robot robot_;
   bool robot_ok_ = false;
+  // Errors CheckInLimit reported: with keep_drawable, a part whose only
+  // errors are these is kept (it can be drawn where it is).
+  std::size_t limit_errors_ = 0;
   std::map<std::string, LoadedTable> tables_;  // by resolved path: a table shared by regions is read once
 };
 
@@ -550,6 +561,7 @@ void Loader::CheckInLimit(int axis, double value, SourceRange where, const std::
   if (!robot_ok_) return;
   const Interval& limit = robot_.limits[static_cast<std::size_t>(axis)];
   if (limit.Contains(value)) return;
+  ++limit_errors_;
   // Computed points (a scan path at the nominal pose, a pallet's far corner)
   // are shown to 1 nm, without the noise of their arithmetic.
   Diagnostic* diag = diags_.Report(DiagKind::CellOutsideRobotLimits, where,
@@ -638,7 +650,7 @@ bool Loader::ReadDifficulty(Keys& keys, Region& region) {
 
 std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
                                          std::vector<Located<std::string>>& names) {
-  const std::size_t errors_before = diags_.error_count();
+  const std::size_t errors_before = diags_.error_count(), limit_errors_before = limit_errors_;
   Region region;
   region.range = Range(table);
   Keys keys(*this, table, fmt::format("[[region]] {}", index + 1), region.range);
@@ -722,7 +734,7 @@ std::optional<Region> Loader::ReadRegion(const toml::table& table, int index,
     CheckInLimit(1, region.y_mm.lo, y ? keys.KeyRange("y_mm") : region.bounds_range, subject + " y_mm.lo");
     CheckInLimit(1, region.y_mm.hi, y ? keys.KeyRange("y_mm") : region.bounds_range, subject + " y_mm.hi");
   }
-  if (diags_.error_count() != errors_before) return std::nullopt;
+  if (Dropped(errors_before, limit_errors_before)) return std::nullopt;
   return region;
 }
 
@@ -941,7 +953,7 @@ void Loader::ReadPocket(Keys& keys, Fixture& fixture) {
 
 std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
                                            std::vector<Located<std::string>>& names) {
-  const std::size_t errors_before = diags_.error_count();
+  const std::size_t errors_before = diags_.error_count(), limit_errors_before = limit_errors_;
   Fixture fixture;
   fixture.range = Range(table);
   Keys keys(*this, table, fmt::format("[[fixture]] {}", index + 1), fixture.range);
@@ -1024,7 +1036,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   }
   if (scan_z) CheckInLimit(2, scan_z->value, keys.KeyRange("scan_z_mm"), "'scan_z_mm'");
   if (place_z) CheckInLimit(2, place_z->value, keys.KeyRange("place_z_mm"), "'place_z_mm'");
-  if (diags_.error_count() != errors_before) return std::nullopt;
+  if (Dropped(errors_before, limit_errors_before)) return std::nullopt;
   return fixture;
 }
 
@@ -1032,7 +1044,7 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
 
 std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
                                          std::vector<Located<std::string>>& names) {
-  const std::size_t errors_before = diags_.error_count();
+  const std::size_t errors_before = diags_.error_count(), limit_errors_before = limit_errors_;
   Feeder feeder;
   feeder.range = Range(table);
   Keys keys(*this, table, fmt::format("[[feeder]] {}", index + 1), feeder.range);
@@ -1108,7 +1120,7 @@ std::optional<Feeder> Loader::ReadFeeder(const toml::table& table, int index,
     CheckPointInLimits(far, keys.KeyRange("pallet"),
                        fmt::format("the far corner (last + back - pick) of the pallet of {}", title));
   }
-  if (diags_.error_count() != errors_before) return std::nullopt;
+  if (Dropped(errors_before, limit_errors_before)) return std::nullopt;
   return feeder;
 }
 
@@ -1304,7 +1316,8 @@ std::optional<Cell> Loader::Load(const toml::table& root, const std::string& pat
   CheckUniqueNames(fixture_names, "fixture");
   CheckUniqueNames(feeder_names, "feeder");
   CheckRegionOverlaps(cell.regions);
-  if (diags_.error_count() != errors_before) return std::nullopt;
+  // keep_drawable: the cell as far as it was read, whatever else is wrong.
+  if (diags_.error_count() != errors_before && !options_.keep_drawable) return std::nullopt;
   for (Region& region : cell.regions) {
     // A region planned for measuring has no table yet: nothing to estimate.
     if (region.has_table) region.interpolation = RegionInterpolation(cell.robot, region.table);
@@ -1405,6 +1418,62 @@ static void CheckScanErrors(const Fixture& fixture, const Cell& cell, Diagnostic
 
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags) {
   for (const Fixture& fixture : cell.fixtures) CheckScanErrors(fixture, cell, diags);
+}
+
+std::array<Point2, 4> PocketCornersInBase(const Fixture& fixture) {
+  SMTCAL_CHECK(fixture.pocket_mm.has_value(), "PocketCornersInBase needs a pocket");
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  const auto& [x, y] = *fixture.pocket_mm;
+  return {ToBase(nominal, {x.lo, y.lo}), ToBase(nominal, {x.hi, y.lo}), ToBase(nominal, {x.hi, y.hi}),
+          ToBase(nominal, {x.lo, y.hi})};
+}
+
+// A length computed from the cell's numbers, to the micrometre.
+static std::string Micro(double mm) { return Num(std::round(mm * 1e3) / 1e3 + 0.0); }
+
+void CheckPockets(const Cell& cell, Diagnostics& diags) {
+  // A cell with no calibrated region yet has nothing to hold a pocket to
+  // (`smtcal import` does not check its boards either).
+  if (cell.regions.empty()) return;
+  for (const Fixture& fixture : cell.fixtures) {
+    if (!fixture.pocket_mm) continue;
+    const std::array<Point2, 4> corners = PocketCornersInBase(fixture);
+    const RegionFit fit = FitInRegion(cell, {corners.begin(), corners.end()});
+    if (fit.fits()) continue;
+    std::string how, advice;
+    if (fit.region == nullptr) {
+      how = "lies outside every calibrated region";
+      advice = "move the pocket onto a region, or calibrate one under it";
+    } else {
+      const Region& region = *fit.region;
+      const std::string extent =
+          fmt::format("region '{}' (x {}..{}, y {}..{} mm, {} x {} mm)", Printable(region.name), Num(region.x_mm.lo),
+                      Num(region.x_mm.hi), Num(region.y_mm.lo), Num(region.y_mm.hi),
+                      Micro(region.x_mm.hi - region.x_mm.lo), Micro(region.y_mm.hi - region.y_mm.lo));
+      if (fit.larger()) {
+        how = fmt::format("is larger than {}", extent);
+        advice = "make the pocket no larger than the region, or calibrate a larger region";
+      } else {
+        std::vector<std::string> past;
+        if (fit.past_x_lo > kRegionFitSlackMm) past.push_back(fmt::format("{} mm past x = {}", Micro(fit.past_x_lo), Num(region.x_mm.lo)));
+        if (fit.past_x_hi > kRegionFitSlackMm) past.push_back(fmt::format("{} mm past x = {}", Micro(fit.past_x_hi), Num(region.x_mm.hi)));
+        if (fit.past_y_lo > kRegionFitSlackMm) past.push_back(fmt::format("{} mm past y = {}", Micro(fit.past_y_lo), Num(region.y_mm.lo)));
+        if (fit.past_y_hi > kRegionFitSlackMm) past.push_back(fmt::format("{} mm past y = {}", Micro(fit.past_y_hi), Num(region.y_mm.hi)));
+        how = fmt::format("sticks out of {}: {}", extent, fmt::join(past, " and "));
+        // The pocket moved so its centre is the region's: in the fixture frame.
+        const Eigen::Affine3d nominal = NominalFix(fixture);
+        const Point2 move = nominal.linear().topLeftCorner<2, 2>().transpose() * fit.CentringMove();
+        const auto& [x, y] = *fixture.pocket_mm;
+        advice = fmt::format("pocket_x_mm = [{}, {}], pocket_y_mm = [{}, {}] centres it on the region; or "
+                             "calibrate a larger region",
+                             Micro(x.lo + move.x()), Micro(x.hi + move.x()), Micro(y.lo + move.y()),
+                             Micro(y.hi + move.y()));
+      }
+    }
+    diags.Report(DiagKind::CellPocketOverRegion, fixture.pocket_range, Printable(fixture.name), Micro(fit.x_lo),
+                 Micro(fit.x_hi), Micro(fit.y_lo), Micro(fit.y_hi), Micro(fit.width()), Micro(fit.height()), how,
+                 advice);
+  }
 }
 
 void ReportTableWarnings(const Cell& cell, Diagnostics& diags) {

@@ -2,6 +2,7 @@
 // (calibration/cell.h).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -26,6 +27,12 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
 // exists is read and validated as always (it is the previous measurement).
 struct CellLoadOptions {
   bool tables_may_be_missing = false;
+  // For a picture of a cell with mistakes (`smtcal cell plot`): the cell is
+  // returned even when errors were reported, with every region, fixture and
+  // feeder that was read cleanly, and those whose only errors are points
+  // outside the robot's travel (so they are drawn where they are). Nothing
+  // but a picture may use such a cell.
+  bool keep_drawable = false;
 };
 Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sources, Diagnostics& diags,
                                      const CellLoadOptions& options);
@@ -37,6 +44,17 @@ Result<std::optional<Cell>> LoadCell(const std::string& path, SourceManager& sou
 // latch later than a quarter of the fixture's max_line_residual_mm
 // (CellTripLatency). verify covers both in its budgets.
 void CheckScanCalibration(const Cell& cell, Diagnostics& diags);
+
+// The corners of a fixture's pocket (it must have one) in the robot base
+// frame at the fixture's nominal pose: lower left, lower right, upper right,
+// upper left of the fixture frame.
+std::array<Point2, 4> PocketCornersInBase(const Fixture& fixture);
+
+// A pocket that is larger than its region or sticks out of it
+// (CellPocketOverRegion, calibration/region_fit.h), at its pocket_x_mm key:
+// a board that fills it has parts no table corrects. Nothing for a cell
+// without calibrated regions. For `smtcal cell check`.
+void CheckPockets(const Cell& cell, Diagnostics& diags);
 
 // The warnings of the cell's error tables (sign changes, errors over half the
 // pitch: what `smtcal table check` shows in full), summarised once per table

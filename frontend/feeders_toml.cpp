@@ -34,12 +34,15 @@ class Reader {
     const std::size_t errors_before = diags_.error_count();
     FeedersFile file;
     file.file = file_;
-    CheckKeys(root, "the feeders file", {"feeder", "map"});
+    CheckKeys(root, "the feeders file", {"feeder", "map", "lane"});
     for (const toml::table* table : Tables(root, "feeder")) {
       if (std::optional<FeederSpec> feeder = Feeder(*table)) file.feeders.push_back(std::move(*feeder));
     }
     for (const toml::table* table : Tables(root, "map")) {
       if (std::optional<FeederRule> rule = Rule(*table)) file.rules.push_back(std::move(*rule));
+    }
+    for (const toml::table* table : Tables(root, "lane")) {
+      if (std::optional<LaneNote> lane = Lane(*table)) file.lanes.push_back(std::move(*lane));
     }
     if (diags_.error_count() != errors_before) return std::nullopt;
     return file;
@@ -163,7 +166,8 @@ class Reader {
     const std::size_t errors_before = diags_.error_count();
     FeederSpec feeder;
     feeder.range = Range(table);
-    CheckKeys(table, "[[feeder]]", {"name", "pick", "package", "value", "rotation_offset_deg", "kind", "pallet"});
+    CheckKeys(table, "[[feeder]]", {"name", "pick", "package", "value", "rotation_offset_deg", "kind", "pallet",
+                                    "part_number", "location", "tape_width_mm", "tape_pitch_mm"});
     if (std::optional<std::string> name = String(table, "name", &feeder.name_range)) feeder.name = *name;
     if (!table.contains("name")) diags_.Report(DiagKind::FeedersMissingKey, feeder.range, "[[feeder]]", "'name'");
     if (std::optional<std::array<double, 4>> pick = Point(table, "pick")) feeder.pick = *pick;
@@ -171,6 +175,10 @@ class Reader {
     feeder.packages = Patterns(table, "package", "a package name or an array of package names");
     if (std::optional<std::string> value = String(table, "value")) feeder.value = *value;
     feeder.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
+    feeder.part_number = String(table, "part_number").value_or("");
+    feeder.location = String(table, "location").value_or("");
+    feeder.tape_width_mm = Number(table, "tape_width_mm", limits::kLengthMm);
+    feeder.tape_pitch_mm = Number(table, "tape_pitch_mm", limits::kLengthMm);
     if (const toml::node* node = table.get("pallet")) {
       if (const toml::table* pallet = node->as_table()) {
         CheckKeys(*pallet, "the pallet", {"last", "back", "columns", "rows"});
@@ -210,7 +218,7 @@ class Reader {
     const std::size_t errors_before = diags_.error_count();
     FeederRule rule;
     rule.range = Range(table);
-    CheckKeys(table, "[[map]]", {"feeder", "lane", "package", "value", "designator", "rotation_offset_deg"});
+    CheckKeys(table, "[[map]]", {"feeder", "lane", "package", "value", "designator", "rotation_offset_deg", "part_number"});
     if (std::optional<std::string> feeder = String(table, "feeder", &rule.feeder_range)) rule.feeder = *feeder;
     if (!table.contains("feeder")) diags_.Report(DiagKind::FeedersMissingKey, rule.range, "[[map]]", "'feeder'");
     rule.packages = Patterns(table, "package", "a package (a chip size or a glob) or an array of them");
@@ -222,8 +230,28 @@ class Reader {
     }
     rule.lane = Count(table, "lane", limits::kPalletPickPoint, &rule.lane_range);
     rule.rotation_offset_deg = Number(table, "rotation_offset_deg", limits::kAngleDeg).value_or(0.0);
+    rule.part_number = String(table, "part_number").value_or("");
     if (diags_.error_count() != errors_before) return std::nullopt;
     return rule;
+  }
+
+  std::optional<LaneNote> Lane(const toml::table& table) {
+    const std::size_t errors_before = diags_.error_count();
+    LaneNote lane;
+    const SourceRange range = Range(table);
+    CheckKeys(table, "[[lane]]", {"feeder", "lane", "value", "package", "part_number", "location", "tape_width_mm",
+                                  "tape_pitch_mm"});
+    if (std::optional<std::string> feeder = String(table, "feeder", &lane.feeder_range)) lane.feeder = *feeder;
+    if (!table.contains("feeder")) diags_.Report(DiagKind::FeedersMissingKey, range, "[[lane]]", "'feeder'");
+    lane.lane = Count(table, "lane", limits::kPalletPickPoint, &lane.lane_range);
+    lane.value = String(table, "value").value_or("");
+    lane.package = String(table, "package").value_or("");
+    lane.part_number = String(table, "part_number").value_or("");
+    lane.location = String(table, "location").value_or("");
+    lane.tape_width_mm = Number(table, "tape_width_mm", limits::kLengthMm);
+    lane.tape_pitch_mm = Number(table, "tape_pitch_mm", limits::kLengthMm);
+    if (diags_.error_count() != errors_before) return std::nullopt;
+    return lane;
   }
 
   const SourceManager& sources_;
@@ -319,26 +347,62 @@ std::optional<FeederTable> FeederTable::Build(const std::vector<cell::Feeder>& c
   }
   std::vector<std::string> names;
   for (const FeederSpec& feeder : table.feeders_) names.push_back(feeder.name);
-  for (FeederRule& rule : file.rules) {
-    std::optional<std::size_t> feeder = find(rule.feeder);
+  // The feeder a [[map]] or a [[lane]] names, and its lane within the
+  // feeder's pick points; nullopt after reporting either.
+  auto resolve = [&](const std::string& name, SourceRange name_range, std::optional<int> lane,
+                     SourceRange lane_range) -> std::optional<std::size_t> {
+    std::optional<std::size_t> feeder = find(name);
     if (!feeder) {
-      std::string closest = ClosestName(rule.feeder, names);
-      diags.Report(DiagKind::FeedersUnknownFeeder, rule.feeder_range, Printable(rule.feeder),
+      std::string closest = ClosestName(name, names);
+      diags.Report(DiagKind::FeedersUnknownFeeder, name_range, Printable(name),
                    closest.empty() ? "" : fmt::format("; did you mean '{}'?", closest));
-      continue;
+      return std::nullopt;
     }
     const FeederSpec& spec = table.feeders_[*feeder];
-    if (rule.lane && *rule.lane > spec.pick_points()) {
-      diags.Report(DiagKind::FeedersBadValue, rule.lane_range, "lane",
+    if (lane && *lane > spec.pick_points()) {
+      diags.Report(DiagKind::FeedersBadValue, lane_range, "lane",
                    fmt::format("a pick point of feeder '{}' (1 to {})", Printable(spec.name), spec.pick_points()),
-                   *rule.lane);
-      continue;
+                   *lane);
+      return std::nullopt;
     }
-    table.rule_feeder_.push_back(*feeder);
-    table.rules_.push_back(std::move(rule));
+    return feeder;
+  };
+  for (FeederRule& rule : file.rules) {
+    if (std::optional<std::size_t> feeder = resolve(rule.feeder, rule.feeder_range, rule.lane, rule.lane_range)) {
+      table.rule_feeder_.push_back(*feeder);
+      table.rules_.push_back(std::move(rule));
+    }
+  }
+  for (LaneNote& lane : file.lanes) {
+    if (std::optional<std::size_t> feeder = resolve(lane.feeder, lane.feeder_range, lane.lane, lane.lane_range)) {
+      table.lane_feeder_.push_back(*feeder);
+      table.lanes_.push_back(std::move(lane));
+    }
   }
   if (diags.error_count() != errors_before) return std::nullopt;
   return table;
+}
+
+LaneDescription FeederTable::Describe(std::size_t feeder, int k) const {
+  const FeederSpec& spec = feeders_[feeder];
+  LaneDescription description{{}, {}, spec.part_number, spec.location, spec.tape_width_mm, spec.tape_pitch_mm};
+  // The feeder-wide [[lane]]s first, then the lane's own: later ones override.
+  for (bool own : {false, true}) {
+    for (std::size_t i = 0; i < lanes_.size(); ++i) {
+      const LaneNote& lane = lanes_[i];
+      if (lane_feeder_[i] != feeder || lane.lane.has_value() != own || (own && *lane.lane != k)) continue;
+      if (!lane.value.empty()) description.value = lane.value;
+      if (!lane.package.empty()) description.package = lane.package;
+      if (!lane.part_number.empty()) description.part_number = lane.part_number;
+      if (!lane.location.empty()) {
+        description.location = lane.location;
+        description.lane_location = own;
+      }
+      if (lane.tape_width_mm) description.tape_width_mm = lane.tape_width_mm;
+      if (lane.tape_pitch_mm) description.tape_pitch_mm = lane.tape_pitch_mm;
+    }
+  }
+  return description;
 }
 
 std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
@@ -350,7 +414,7 @@ std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
     if (!any(rule.packages, [&](const std::string& p) { return PackageMatch(p, row.package); })) continue;
     if (!any(rule.values, [&](const std::string& p) { return GlobMatch(p, row.value); })) continue;
     if (!any(rule.designators, [&](const std::string& p) { return GlobMatch(p, row.designator); })) continue;
-    return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg};
+    return FeederMatch{rule_feeder_[r], rule.lane, rule.rotation_offset_deg, rule.part_number};
   }
   std::optional<FeederMatch> best;
   int best_score = 0;
@@ -359,7 +423,7 @@ std::optional<FeederMatch> FeederTable::Find(const Row& row) const {
     int score = Specificity(feeders_[f], row, lane);
     if (score > best_score) {
       best_score = score;
-      best = FeederMatch{f, lane, feeders_[f].rotation_offset_deg};
+      best = FeederMatch{f, lane, feeders_[f].rotation_offset_deg, {}};
     }
   }
   return best;

@@ -12,6 +12,11 @@
 //   kind = "tape"                       # or "tray" (cell.h, FeederKind)
 //   pallet = { last = [..], back = [..], columns = 4, rows = 2 }
 //
+//   part_number = "BC847B,215"          # for the set-up sheet (these four keys on
+//   tape_width_mm = 8                   # [[lane]] too; none of them decides where
+//   tape_pitch_mm = 4                   # a part goes)
+//   location = "bank 2, slot 7"         # where the operator finds it
+//
 //   [[map]]                             # first matching rule wins
 //   feeder = "Bank1"                    # a feeder of the cell or of this file
 //   lane = 3                            # a pallet feeder's pick point k (Pallet(n, k)); default: next pocket
@@ -19,6 +24,17 @@
 //   value = "10k"                       # each a glob or an array of globs
 //   designator = ["R1", "R2", "R7*"]
 //   rotation_offset_deg = 90.0
+//   part_number = "RC0603FR-0710KL"     # the parts it maps, for the set-up sheet
+//
+//   [[lane]]                            # what a lane (or pocket) holds, for the set-up sheet
+//   feeder = "Bank1"                    # a feeder of the cell or of this file
+//   lane = 3                            # omitted: every lane of the feeder
+//   value = "10k"                       # what it holds (a program has no list to say)
+//   package = "0805"
+//   part_number = "RC0805FR-0710KL"
+//   tape_width_mm = 8
+//   tape_pitch_mm = 4
+//   location = "bank 1, slot 3"
 //
 // A part goes to the first [[map]] that matches it; else to the feeder whose
 // package and value match it most specifically (both > one > none given is
@@ -53,6 +69,10 @@ struct FeederSpec {
   double rotation_offset_deg = 0;
   cell::FeederKind kind = cell::FeederKind::kTape;  // as the cell's `kind` (cell.h), same default
   bool from_cell = false;
+  // For the set-up sheet only (a cell's feeders get them from [[lane]]).
+  std::string part_number;
+  std::string location;
+  std::optional<double> tape_width_mm, tape_pitch_mm;
 
   bool is_pallet() const { return pallet_last.has_value(); }
   // A pallet of tapes whose `package` array names each lane's package.
@@ -76,12 +96,34 @@ struct FeederRule {
   std::optional<int> lane;  // 1-based pick point of a pallet feeder
   SourceRange lane_range;
   double rotation_offset_deg = 0;
+  std::string part_number;  // of the parts it maps, for the set-up sheet
+};
+
+// [[lane]]: what a feeder's lane or pocket holds, for the set-up sheet; it
+// decides nothing about where parts go.
+struct LaneNote {
+  std::string feeder;
+  SourceRange feeder_range;
+  std::optional<int> lane;  // nullopt: every lane of the feeder
+  SourceRange lane_range;
+  std::string value, package, part_number, location;
+  std::optional<double> tape_width_mm, tape_pitch_mm;
 };
 
 struct FeedersFile {
   std::uint32_t file = 0;
   std::vector<FeederSpec> feeders;
   std::vector<FeederRule> rules;
+  std::vector<LaneNote> lanes;
+};
+
+// What the set-up sheet knows of one lane: [[lane]] for that lane, over
+// [[lane]] for its whole feeder, over the feeder's own keys. value and
+// package come from [[lane]] only (a feeder's are patterns for matching).
+struct LaneDescription {
+  std::string value, package, part_number, location;
+  std::optional<double> tape_width_mm, tape_pitch_mm;
+  bool lane_location = false;  // `location` is the lane's own (else its feeder's, or none)
 };
 
 // Reads a feeders file. A file that cannot be read is an Error; mistakes in
@@ -94,6 +136,7 @@ struct FeederMatch {
   std::size_t feeder = 0;  // index into FeederTable::feeders()
   std::optional<int> lane;
   double rotation_offset_deg = 0;
+  std::string part_number;  // a [[map]]'s, for the set-up sheet
 };
 
 class FeederTable {
@@ -106,6 +149,8 @@ class FeederTable {
 
   std::optional<FeederMatch> Find(const Row& row) const;
   const std::vector<FeederSpec>& feeders() const { return feeders_; }
+  // What the set-up sheet knows of pick point k (1-based) of feeders()[feeder].
+  LaneDescription Describe(std::size_t feeder, int k) const;
   // Whether a [[map]] looks at designators (else Find depends only on the
   // package and the value, and its answers can be cached by them).
   bool matches_designators() const {
@@ -119,6 +164,8 @@ class FeederTable {
   std::vector<FeederSpec> feeders_;
   std::vector<FeederRule> rules_;
   std::vector<std::size_t> rule_feeder_;  // per rule
+  std::vector<LaneNote> lanes_;
+  std::vector<std::size_t> lane_feeder_;  // per [[lane]]
 };
 
 }  // namespace smtcal::cad

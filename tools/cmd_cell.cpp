@@ -4,6 +4,7 @@
 // are in frontend/cell_toml.cpp; this file only wires the file, the options,
 // the summary and the exit codes.
 #include <filesystem>
+#include <map>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -16,9 +17,10 @@
 #include "calibration/fixture_geometry.h"
 #include "calibration/scan_plan.h"
 #include "frontend/cell_toml.h"
+#include "ir/symbols.h"
+#include "passes/compile_pipeline.h"
 #include "passes/correction/compile_state.h"
 #include "tools/commands.h"
-#include "tools/compile_or_report.h"
 
 namespace smtcal::tools {
 namespace {
@@ -198,6 +200,15 @@ std::string SummaryJson(const cell::Cell& cell) {
   return JsonText(out);
 }
 
+// The checks `cell check` makes of a loaded cell beyond the loader's own
+// (`table_warnings`: unless the compile pipeline has made that one).
+void CheckCell(const cell::Cell& cell, Diagnostics& diags, bool table_warnings) {
+  cell::CheckScanCalibration(cell, diags);
+  if (table_warnings) cell::ReportTableWarnings(cell, diags);
+  cell::ReportGridAdvice(cell, diags);
+  cell::CheckPockets(cell, diags);
+}
+
 void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
   SourceManager sources;
   Diagnostics diags(sources);
@@ -206,11 +217,7 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
     options.exit_code = ReportIoError(loaded.error());
     return;
   }
-  if (loaded.value()) {
-    cell::CheckScanCalibration(*loaded.value(), diags);
-    cell::ReportTableWarnings(*loaded.value(), diags);
-    cell::ReportGridAdvice(*loaded.value(), diags);
-  }
+  if (loaded.value()) CheckCell(*loaded.value(), diags, true);
   options.exit_code = PrintDiagnostics(diags, options);
   if (!loaded.value()) return;  // the errors were printed
   const cell::Cell& cell = *loaded.value();
@@ -218,51 +225,93 @@ void RunCheck(const std::string& path, bool json, GlobalOptions& options) {
   if (!written) options.exit_code = ReportIoError(written.error());
 }
 
+// The program's targets for the picture, each statement's runs numbered.
+std::vector<PlottedTarget> PlotTargets(const CompileState& state) {
+  std::vector<PlottedTarget> targets;
+  std::map<const ir::Stmt*, int> runs;
+  for (const Target& target : state.targets) {
+    if (target.known) ++runs[target.stmt];
+  }
+  std::map<const ir::Stmt*, int> seen;
+  for (const Target& target : state.targets) {
+    if (!target.known) continue;
+    targets.push_back({target.text, target.required[0], target.required[1], target.required[3], target.is_placement(),
+                       target.fixture, sema::StmtRange(*target.stmt), ++seen[target.stmt], runs[target.stmt]});
+  }
+  return targets;
+}
+
 // `smtcal cell plot CELL.toml -o FILE.svg [--program P.place]`: the cell as
 // a picture (backend/reports/cell_plot.h); with a program, its placements
-// where the correction passes put them at the fixtures' nominal poses.
+// where the correction passes put them at the fixtures' nominal poses. A
+// cell with errors is drawn as far as it was read, every error and warning
+// ringed where it is; the exit code is `cell check`'s (with a program,
+// `verify`'s too), but the picture is written.
 void RunPlot(const std::string& path, const std::string& output, const std::string& program_path,
              GlobalOptions& options) {
   if (FilesClash({{"CELL", path}, {"--program", program_path}}, {{"-o", output}})) {
     options.exit_code = kExitUsageError;
     return;
   }
-  SourceManager sources;
-  Diagnostics diags(sources);
-  std::vector<PlottedTarget> targets;
-  std::optional<cell::Cell> cell;
-  if (program_path.empty()) {
-    Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, sources, diags);
-    if (!loaded) {
-      options.exit_code = ReportIoError(loaded.error());
-      return;
-    }
-    cell = std::move(loaded).value();
-  } else {
-    CompiledProgram compiled;
-    if (!CompileForCellOrReport(program_path, path, false, sources, diags, compiled, options)) return;
-    cell = std::move(compiled.cell);
-    if (compiled.program.compile != nullptr) {
-      for (const Target& target : compiled.program.compile->targets) {
-        if (!target.known) continue;
-        targets.push_back({target.text, target.required[0], target.required[1], target.is_placement(),
-                           target.fixture});
-      }
-    }
+  // The cell as far as it can be drawn, with its own diagnostics.
+  SourceManager cell_sources;
+  Diagnostics cell_diags(cell_sources);
+  cell::CellLoadOptions drawable;
+  drawable.keep_drawable = true;
+  Result<std::optional<cell::Cell>> loaded = cell::LoadCell(path, cell_sources, cell_diags, drawable);
+  if (!loaded) {
+    PrintDiagnostics(cell_diags, options);
+    options.exit_code = ReportIoError(loaded.error());
+    return;
   }
-  options.exit_code = PrintDiagnostics(diags, options);
-  if (!cell || options.exit_code != kExitOk) {
+  if (!loaded.value()) {  // not a cell file at all: nothing to draw
+    options.exit_code = PrintDiagnostics(cell_diags, options);
     if (options.exit_code == kExitOk) options.exit_code = kExitInputError;
     return;
   }
+  // A clean cell and a program: the program compiled for it (the cell loaded
+  // again by the pipeline), its diagnostics and the cell's in one list.
+  SourceManager sources;
+  Diagnostics diags(sources);
+  CompiledProgram compiled;
+  std::string program_note;
+  const bool with_program = !program_path.empty() && !cell_diags.has_errors();
+  if (!program_path.empty() && cell_diags.has_errors()) {
+    program_note = fmt::format("the placements of {} are not drawn: the cell has errors",
+                               std::filesystem::path(program_path).filename().string());
+  }
+  if (with_program) {
+    Result<std::uint32_t> file = sources.Load(program_path);
+    if (!file) {
+      options.exit_code = ReportIoError(file.error());
+      return;
+    }
+    Result<bool> ran = smtcal::CompileForCell(file.value(), path, false, sources, diags, compiled);
+    if (!ran) {
+      PrintDiagnostics(diags, options);
+      options.exit_code = ReportIoError(ran.error());
+      return;
+    }
+  }
+  const cell::Cell& cell = with_program && compiled.cell ? *compiled.cell : *loaded.value();
+  Diagnostics& shown = with_program ? diags : cell_diags;
+  CheckCell(cell, shown, !with_program);
+  std::vector<PlottedTarget> targets;
+  if (with_program && compiled.program.compile != nullptr) targets = PlotTargets(*compiled.program.compile);
+  const std::vector<PlotFinding> findings = LocateFindings(cell, targets, shown);
+  options.exit_code = PrintDiagnostics(shown, options);
   const std::string title = std::filesystem::path(path).filename().string();
   const std::string program = program_path.empty() ? "" : std::filesystem::path(program_path).filename().string();
-  Status written = WriteFileAtomically(output, PlotCellSvg(*cell, title, program, targets));
+  Status written = WriteFileAtomically(output, PlotCellSvg(cell, title, program, targets, findings, program_note));
   if (!written) {
     options.exit_code = ReportIoError(written.error());
     return;
   }
-  SayDone(options, output, fmt::format("wrote the picture {}", output));
+  SayDone(options, output,
+          findings.empty() ? fmt::format("wrote the picture {}", output)
+                           : fmt::format("wrote the picture {} ({} error{} and {} warning{} marked)", output,
+                                         shown.error_count(), shown.error_count() == 1 ? "" : "s",
+                                         shown.warning_count(), shown.warning_count() == 1 ? "" : "s"));
 }
 
 }  // namespace
@@ -289,7 +338,10 @@ void AddCellCommand(CLI::App& app, GlobalOptions& options) {
   CLI::App* plot = cell->add_subcommand(
       "plot", "Draw the cell as an SVG picture: the robot's travel, the regions with their tables' extent,\n"
               "the fixtures with markers, scan paths and nominal trips, the feeders with their lanes and\n"
-              "pockets, and with --program the program's placements (docs/cell.md)");
+              "pockets, and with --program the program's placements and each part's orientation. Every\n"
+              "error and warning of the cell (and the program) is ringed in red where it is and listed;\n"
+              "a cell with errors is drawn as far as it was read, and the exit code is cell check's\n"
+              "(with --program verify's too), the picture written all the same (docs/cell.md)");
   plot->add_option("CELL", plot_path, "the cell file")->required();
   plot->add_option("-o,--output", plot_output, "the SVG file to write ('-' for stdout)")->required();
   plot->add_option("--program", plot_program, "a .place program whose placements to draw on the fixtures");

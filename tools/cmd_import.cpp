@@ -50,6 +50,9 @@ struct ImportCliOptions {
   std::string report;       // --report FILE.json
   std::string setup_sheet;  // --setup-sheet FILE: the feeder set-up sheet as text
   std::string setup_csv;    // --setup-csv FILE: the same as CSV
+  std::string setup_svg;    // --setup-svg FILE: the same as a printable page
+  std::uint64_t lot_boards = 0;     // --boards N: the lot, for the set-up sheet
+  double spares_percent = 2;        // --spares PCT
   double rotation_deg = 0;
   std::string panel = "1x1";
   std::string pitch = "0,0";
@@ -286,7 +289,8 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
                  {{"-o", opt.output},
                   {"--report", opt.report},
                   {"--setup-sheet", opt.setup_sheet},
-                  {"--setup-csv", opt.setup_csv}})) {
+                  {"--setup-csv", opt.setup_csv},
+                  {"--setup-svg", opt.setup_svg}})) {
     options.exit_code = kExitUsageError;
     return;
   }
@@ -334,6 +338,8 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
     import.centre_spot = spot->first;
     import.centre_spot_name = spot->second;
   }
+  import.cell = &*cell;
+  import.cell_fixture = fixture;
   const std::string place_z_source =
       opt.place_z_mm ? std::string("--place-z") : fmt::format("place_z_mm of fixture {}", fixture->name);
   const double place_z = import.place_z_mm;
@@ -369,8 +375,12 @@ void RunImport(const ImportCliOptions& opt, GlobalOptions& options) {
   if (!opt.report.empty()) {
     outputs.emplace_back(opt.report, ImportReportJson(importer.summary(), importer.fates(), BaseName(opt.list)));
   }
-  if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(importer.setup_sheet()));
-  if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(importer.setup_sheet()));
+  SetupSheet sheet = importer.setup_sheet();
+  sheet.lot_boards = opt.lot_boards;
+  sheet.spares_percent = opt.spares_percent;
+  if (!opt.setup_sheet.empty()) outputs.emplace_back(opt.setup_sheet, SetupSheetText(sheet));
+  if (!opt.setup_csv.empty()) outputs.emplace_back(opt.setup_csv, SetupSheetCsv(sheet));
+  if (!opt.setup_svg.empty()) outputs.emplace_back(opt.setup_svg, SetupSheetSvg(sheet));
   Status written = WriteFilesAtomically(outputs);
   if (!written) {
     SaySummary(summary);
@@ -497,6 +507,15 @@ void AddImportCommand(CLI::App& app, GlobalOptions& options) {
   cmd->add_option("--setup-sheet", opt.setup_sheet,
                   "write the feeder set-up sheet, which part goes in which feeder, lane or pocket, as a text table");
   cmd->add_option("--setup-csv", opt.setup_csv, "write the feeder set-up sheet as CSV");
+  cmd->add_option("--setup-svg", opt.setup_svg, "write the feeder set-up sheet as a printable SVG page");
+  AddNumberOption(*cmd, "--boards", opt.lot_boards,
+                  "the lot's boards, for the set-up sheet: each slot's parts for the lot (a panel's boards a cycle) "
+                  "and its spares",
+                  limits::kLotBoards);
+  AddNumberOption(*cmd, "--spares", opt.spares_percent,
+                  "the set-up sheet's spares per slot with --boards, percent of the lot's parts, rounded up",
+                  limits::kSparesPercent)
+      ->capture_default_str();
   cmd->footer(
       "Every row becomes a placement or a diagnostic at its line; the summary on stderr counts rows\n"
       "read, placed and skipped by reason. Exit codes: 0 ok, 1 errors in the list, the cell or the\n"

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -24,12 +25,17 @@ constexpr std::string_view kMarker = "#b2182b";
 constexpr std::string_view kPocket = "#1a9641";
 constexpr std::string_view kFeeder = "#7b3294";
 constexpr std::string_view kPlace = "#1b1b1b";
+constexpr std::string_view kFinding = "#e31a1c";  // errors and warnings: red, the picture's only red fill
 
 constexpr double kLeft = 70;          // room for the y ticks
 constexpr double kPanelWidth = 760;   // the widest a panel's plot area gets
 constexpr double kGapBelow = 96;      // below a plot area: x ticks, axis name, scale bar
 constexpr double kTitleHeight = 34;   // above a plot area: its title
 constexpr double kLegendWidth = 300;
+constexpr double kFindingRadius = 7;   // px: the ring around a finding's place
+constexpr double kFindingRow = 16;     // px: one line of the findings' list
+constexpr double kListCharPx = 6.2;    // px: a generous character of the list's 11 px text
+constexpr std::size_t kFindingLines = 4;  // a finding's words take at most this many lines
 
 std::string Num(double v) { return SvgNum(v); }
 
@@ -99,7 +105,7 @@ std::array<Eigen::Vector2d, 4> PocketCorners(const cell::Fixture& fixture) {
 // after every mark of a panel is drawn, so none covers a mark or another
 // label: each tries places around its mark, nearest first (its preferred
 // side first), and is drawn with a thin leader line when it had to move
-// away; one that finds no room is left out and counted (the panel says how
+// away or to another side; one that finds no room is left out and counted (the panel says how
 // many).
 struct Label {
   std::string text;
@@ -128,6 +134,8 @@ class LabelPlacer {
   // A mark labels must not cover (a square of half side `half` around x, y).
   void Block(double x, double y, double half) { taken_.push_back({x - half, y - half, x + half, y + half}); }
   void Add(Label label) { labels_.push_back(std::move(label)); }
+  // A label placed before every other (a finding's number).
+  void AddFirst(Label label) { labels_.insert(labels_.begin() + static_cast<std::ptrdiff_t>(first_++), std::move(label)); }
 
   // Places the labels in the order they were added; returns how many found
   // no room.
@@ -150,7 +158,9 @@ class LabelPlacer {
             continue;
           }
           taken_.push_back(box);
-          if (ring > 0) {
+          // Away from its mark, or on another side than its own: a leader
+          // says whose name it is.
+          if (ring > 0 || i > 0) {
             const double px = std::clamp(label.x, box.x0, box.x1), py = std::clamp(label.y, box.y0, box.y1);
             svg += fmt::format("    <line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"#888\" stroke-width=\"0.5\"/>\n",
                                Num(label.x), Num(label.y), Num(px), Num(py));
@@ -169,19 +179,17 @@ class LabelPlacer {
   }
 
  private:
-  static std::size_t Utf8Columns(const std::string& text) {
-    std::size_t n = 0;
-    for (char c : text) n += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
-    return n;
-  }
   Rect area_;
   std::vector<Rect> taken_;
   std::vector<Label> labels_;
+  std::size_t first_ = 0;  // labels added with AddFirst
 };
 
 class CellPainter {
  public:
-  CellPainter(const cell::Cell& cell, const std::vector<PlottedTarget>& targets) : cell_(cell), targets_(targets) {}
+  CellPainter(const cell::Cell& cell, const std::vector<PlottedTarget>& targets,
+              const std::vector<PlotFinding>& findings)
+      : cell_(cell), targets_(targets), findings_(findings) {}
 
   // What the whole-cell panel shows: the travel and everything in the cell.
   Box CellBox() const {
@@ -196,6 +204,9 @@ class CellPainter {
     for (std::size_t f = 0; f < cell_.fixtures.size(); ++f) AddFixture(box, f);
     AddFeeders(box);
     for (const PlottedTarget& target : targets_) box.Add(target.x_mm, target.y_mm);
+    for (const PlotFinding& finding : findings_) {
+      for (const Eigen::Vector2d& p : finding.marks_mm) box.Add(p);
+    }
     return box.Padded(0.04, 5);
   }
   Box FixtureBox(std::size_t f) const {
@@ -214,14 +225,20 @@ class CellPainter {
 
   // Everything, into one panel; `detail` numbers trips and lanes and names
   // the placements (the close-ups). Returns how many names found no room.
+  // The group carries the panel's mapping from mm to px (cell_plot.h).
   int Draw(std::string& svg, const View& view, const std::string& clip, bool detail) const {
-    svg += fmt::format("  <g clip-path=\"url(#{})\">\n", clip);
+    svg += fmt::format(
+        "  <g clip-path=\"url(#{})\" data-x0-mm=\"{}\" data-y1-mm=\"{}\" data-px-per-mm=\"{}\" "
+        "data-left-px=\"{}\" data-top-px=\"{}\">\n",
+        clip, fmt::format("{:.6f}", view.world.x0), fmt::format("{:.6f}", view.world.y1),
+        fmt::format("{:.9f}", view.scale), Num(view.left), Num(view.top));
     LabelPlacer labels({view.left + 2, view.top + 2, view.left + view.width() - 2, view.top + view.height() - 2});
     DrawTravel(svg, view);
     DrawRegions(svg, view, detail, labels);
     for (std::size_t f = 0; f < cell_.fixtures.size(); ++f) DrawFixture(svg, view, cell_.fixtures[f], detail, labels);
     DrawFeeders(svg, view, detail, labels);
     DrawTargets(svg, view, detail, labels);
+    DrawFindings(svg, view, labels);
     const int left_out = labels.Draw(svg);
     svg += "  </g>\n";
     return left_out;
@@ -324,8 +341,19 @@ class CellPainter {
       labels.Add({std::string(corner_names[c]), view.Px(frame[c].x()), view.Py(frame[c].y()), 10, kFixture,
                   corner_side[c], 3});
     }
+    // Trips closer than a mark's width (0.2 mm apart, a leg's way in and its
+    // way out) are one mark: one label names them all, "T2, T3".
+    std::vector<bool> named(trips.size(), false);
     for (std::size_t k = 0; k < trips.size(); ++k) {
-      labels.Add({TripName(k), view.Px(trips[k].x()), view.Py(trips[k].y()), 9, "#000", k % 2 == 0 ? kSideRight : kSideLeft, 4});
+      if (named[k]) continue;
+      std::string text = TripName(k);
+      for (std::size_t j = k + 1; j < trips.size(); ++j) {
+        if (!named[j] && (trips[j] - trips[k]).norm() * view.scale < 6) {
+          named[j] = true;
+          text += ", " + TripName(j);
+        }
+      }
+      labels.Add({text, view.Px(trips[k].x()), view.Py(trips[k].y()), 9, "#000", k % 2 == 0 ? kSideRight : kSideLeft, 4});
     }
   }
 
@@ -357,15 +385,51 @@ class CellPainter {
     for (const PlottedTarget& target : targets_) {
       if (!target.place) continue;
       const double x = view.Px(target.x_mm), y = view.Py(target.y_mm);
-      svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{}\"/>\n", Num(x), Num(y), detail ? 2.2 : 1.6,
-                         kPlace);
-      labels.Block(x, y, detail ? 2.2 : 1.6);
-      if (detail) labels.Add({target.name, x, y, 7, "#333", kSideRight, 3});
+      const double r = detail ? 2.2 : 1.6;
+      // The part's orientation: a tick from the dot toward its u (0° along
+      // +x, counter-clockwise; y is up in the world, down on the screen).
+      const double tick = detail ? 7 : 4.5, u = target.u_deg * std::numbers::pi / 180;
+      svg += fmt::format("    <line x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"{}\" stroke-width=\"{}\"/>\n",
+                         Num(x), Num(y), Num(x + tick * std::cos(u)), Num(y - tick * std::sin(u)), kPlace,
+                         detail ? 1.1 : 0.8);
+      svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{}\"/>\n", Num(x), Num(y), r, kPlace);
+      labels.Block(x, y, r);
+      labels.Block(x + tick * std::cos(u), y - tick * std::sin(u), 1);
+      if (!detail) continue;
+      const std::string name =
+          target.runs > 1 ? fmt::format("{} ({}/{})", target.name, target.run, target.runs) : target.name;
+      labels.Add({name, x, y, 7, "#333", kSideRight, tick + 2});  // clear of the tick
+    }
+  }
+
+  // Every finding's places: a red ring each (a shape it concerns outlined
+  // in red), numbered as in the list below the panels.
+  void DrawFindings(std::string& svg, const View& view, LabelPlacer& labels) const {
+    for (std::size_t i = 0; i < findings_.size(); ++i) {
+      const PlotFinding& finding = findings_[i];
+      if (finding.outline_mm.size() > 1) {
+        std::string points;
+        for (const Eigen::Vector2d& p : finding.outline_mm) points += (points.empty() ? "" : " ") + view.P(p);
+        svg += fmt::format("    <polygon points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" "
+                           "stroke-dasharray=\"5 3\"/>\n",
+                           points, kFinding);
+      }
+      for (const Eigen::Vector2d& p : finding.marks_mm) {
+        const double x = view.Px(p.x()), y = view.Py(p.y());
+        svg += fmt::format(
+            "    <circle class=\"finding\" data-finding=\"{}\" data-kind=\"{}\" data-x-mm=\"{}\" data-y-mm=\"{}\" "
+            "cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\"/>\n",
+            i + 1, DiagKindName(finding.kind), fmt::format("{:.4f}", p.x()), fmt::format("{:.4f}", p.y()), Num(x),
+            Num(y), Num(kFindingRadius), kFinding, finding.severity == Severity::Error ? 2.5 : 1.5);
+        labels.Block(x, y, kFindingRadius);
+        labels.AddFirst({std::to_string(i + 1), x, y, 10, kFinding, kSideAbove, kFindingRadius});
+      }
     }
   }
 
   const cell::Cell& cell_;
   const std::vector<PlottedTarget>& targets_;
+  const std::vector<PlotFinding>& findings_;
 };
 
 // Axes in mm around a plot area, ticks at round numbers, and a scale bar.
@@ -400,7 +464,7 @@ void DrawAxes(std::string& svg, const View& view) {
                      Num(bar_y + 1), SvgTickText(bar_mm, bar_mm));
 }
 
-void DrawLegend(std::string& svg, double x, double y, bool program) {
+void DrawLegend(std::string& svg, double x, double y, bool program, bool findings) {
   struct Entry {
     std::string mark;
     std::string_view text;
@@ -440,8 +504,20 @@ void DrawLegend(std::string& svg, double x, double y, bool program) {
        "a feeder's pick point (lane or pocket k)"},
   };
   if (program) {
-    entries.push_back({fmt::format("<circle cx=\"{}\" cy=\"0\" r=\"2.2\" fill=\"{}\"/>", Num(mx), kPlace),
-                       "a placement of the program (nominal pose)"});
+    entries.push_back({fmt::format("<circle cx=\"{}\" cy=\"0\" r=\"2.2\" fill=\"{}\"/><line x1=\"{}\" y1=\"0\" "
+                                   "x2=\"{}\" y2=\"0\" stroke=\"{}\" stroke-width=\"1.1\"/>",
+                                   Num(mx), kPlace, Num(mx), Num(mx + 7), kPlace),
+                       "a placement (nominal pose), tick: its u"});
+  }
+  if (findings) {
+    entries.push_back({fmt::format("<circle cx=\"{}\" cy=\"0\" r=\"{}\" fill=\"none\" stroke=\"{}\" "
+                                   "stroke-width=\"2.5\"/>",
+                                   Num(mx), Num(kFindingRadius), kFinding),
+                       "an error where it is (numbered, listed below)"});
+    entries.push_back({fmt::format("<circle cx=\"{}\" cy=\"0\" r=\"{}\" fill=\"none\" stroke=\"{}\" "
+                                   "stroke-width=\"1.5\"/>",
+                                   Num(mx), Num(kFindingRadius), kFinding),
+                       "a warning where it is (numbered, listed below)"});
   }
   svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"13\" font-weight=\"bold\">Legend</text>\n", Num(x),
                      Num(y));
@@ -452,11 +528,89 @@ void DrawLegend(std::string& svg, double x, double y, bool program) {
   }
 }
 
+// A finding's words wrapped into lines of at most `chars` characters (a
+// word longer than a line gets a line of its own), at most `max_lines` of
+// them, the last ending in "…" when words were left.
+std::vector<std::string> Wrapped(const std::string& text, std::size_t chars, std::size_t max_lines) {
+  std::vector<std::string> lines(1);
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    start = end + 1;
+    if (!lines.back().empty() && Utf8Columns(lines.back()) + 1 + Utf8Columns(word) > chars) {
+      if (lines.size() == max_lines) {
+        lines.back() += " …";
+        return lines;
+      }
+      lines.emplace_back();
+    }
+    lines.back() += (lines.back().empty() ? "" : " ") + word;
+  }
+  return lines;
+}
+
+// The list's lines: per finding, its head (severity, kind, where, what is
+// marked) and its words wrapped to the picture's width.
+std::vector<std::vector<std::string>> FindingLines(const std::vector<PlotFinding>& findings, double width) {
+  const std::size_t chars = static_cast<std::size_t>(std::max(60.0, (width - 20 - 24 - 20) / kListCharPx));
+  std::vector<std::vector<std::string>> out;
+  for (const PlotFinding& finding : findings) {
+    std::vector<std::string> lines = {fmt::format(
+        "{} {}{}{}{}", SeverityName(finding.severity), DiagKindName(finding.kind),
+        finding.where.empty() ? "" : " at " + finding.where,
+        finding.subject.empty() ? "" : fmt::format(": {}", finding.subject),
+        finding.marks_mm.empty() ? " [not drawn]" : "")};
+    for (std::string& line : Wrapped(finding.message, chars, kFindingLines)) lines.push_back(std::move(line));
+    out.push_back(std::move(lines));
+  }
+  return out;
+}
+
+double FindingListHeight(const std::vector<std::vector<std::string>>& lines) {
+  double height = 20;
+  for (const auto& finding : lines) height += kFindingRow * static_cast<double>(finding.size()) + 4;
+  return height;
+}
+
+// The findings under the panels: number, severity, kind, where, what is
+// marked (bold), then the diagnostic's words.
+void DrawFindingList(std::string& svg, const std::vector<PlotFinding>& findings,
+                     const std::vector<std::vector<std::string>>& lines, double x, double y) {
+  std::size_t errors = 0, unmarked = 0;
+  for (const PlotFinding& finding : findings) {
+    errors += finding.severity == Severity::Error;
+    unmarked += finding.marks_mm.empty();
+  }
+  svg += fmt::format("  <text x=\"{}\" y=\"{}\" font-size=\"14\" font-weight=\"bold\">{} error{}, {} warning{}{}</text>\n",
+                     Num(x), Num(y), errors, errors == 1 ? "" : "s", findings.size() - errors,
+                     findings.size() - errors == 1 ? "" : "s",
+                     unmarked == 0 ? std::string(": each ringed in red where it is")
+                                   : fmt::format(", each ringed in red where it is ({} with no place in the picture: "
+                                                 "listed only)",
+                                                 unmarked));
+  double row = y + 20;
+  for (std::size_t i = 0; i < findings.size(); ++i) {
+    svg += fmt::format("  <g class=\"finding-entry\" data-finding=\"{}\" font-size=\"11\">", i + 1);
+    svg += fmt::format("<text x=\"{}\" y=\"{}\" font-weight=\"bold\" fill=\"{}\">{}</text>", Num(x), Num(row), kFinding,
+                       i + 1);
+    for (std::size_t l = 0; l < lines[i].size(); ++l) {
+      svg += fmt::format("<text x=\"{}\" y=\"{}\"{}>{}</text>", Num(x + 24),
+                         Num(row + kFindingRow * static_cast<double>(l)), l == 0 ? " font-weight=\"bold\"" : "",
+                         SvgEscape(lines[i][l]));
+    }
+    svg += "</g>\n";
+    row += kFindingRow * static_cast<double>(lines[i].size()) + 4;
+  }
+}
+
 }  // namespace
 
 std::string PlotCellSvg(const cell::Cell& cell, std::string_view title, std::string_view program,
-                        const std::vector<PlottedTarget>& targets) {
-  CellPainter painter(cell, targets);
+                        const std::vector<PlottedTarget>& targets, const std::vector<PlotFinding>& findings,
+                        std::string_view program_note) {
+  CellPainter painter(cell, targets, findings);
   struct Panel {
     View view;
     std::string title;
@@ -480,7 +634,10 @@ std::string PlotCellSvg(const cell::Cell& cell, std::string_view title, std::str
     top += panels.back().view.height() + kGapBelow + kTitleHeight;
   }
   const double width = kLeft + kPanelWidth + 40 + kLegendWidth;
-  const double height = top - kTitleHeight + 10;
+  double height = top - kTitleHeight + 10;
+  const double list_top = height + 10;
+  const std::vector<std::vector<std::string>> finding_lines = FindingLines(findings, width);
+  if (!findings.empty()) height = list_top + FindingListHeight(finding_lines) + 10;
 
   std::string svg;
   svg += fmt::format(
@@ -500,7 +657,9 @@ std::string PlotCellSvg(const cell::Cell& cell, std::string_view title, std::str
   svg += fmt::format(
       "  <text x=\"20\" y=\"50\" fill=\"#333\">robot base frame, mm, y up; robot {}{}</text>\n",
       SvgEscape(cell.robot.model.empty() ? std::string("(no model given)") : cell.robot.model),
-      program.empty() ? std::string() : fmt::format("; the placements of {} at the fixture's nominal pose", SvgEscape(program)));
+      program.empty()        ? std::string()
+      : program_note.empty() ? fmt::format("; the placements of {} at the fixture's nominal pose", SvgEscape(program))
+                             : fmt::format("; {}", SvgEscape(program_note)));
   for (std::size_t p = 0; p < panels.size(); ++p) {
     const Panel& panel = panels[p];
     svg += fmt::format("  <!-- panel: {} -->\n", SvgEscape(panel.title));
@@ -515,7 +674,8 @@ std::string PlotCellSvg(const cell::Cell& cell, std::string_view title, std::str
                          left_out, left_out == 1 ? "" : "s", left_out == 1 ? "its" : "their");
     }
   }
-  DrawLegend(svg, kLeft + kPanelWidth + 40, panels.front().view.top + 4, !targets.empty());
+  DrawLegend(svg, kLeft + kPanelWidth + 40, panels.front().view.top + 4, !targets.empty(), !findings.empty());
+  if (!findings.empty()) DrawFindingList(svg, findings, finding_lines, 20, list_top);
   svg += "</svg>\n";
   return svg;
 }

@@ -136,6 +136,192 @@ std::vector<std::string> Suggestions(const cell::Cell& cell, const cell::Fixture
   return out;
 }
 
+// One row of the estimator table: `fixture`'s pose from its nominal trips
+// with its estimator, and the scan's part of the budget at `points` (their
+// regions and tolerances filled).
+ScanReportEstimator EstimatorRow(const cell::Cell& cell, const cell::Fixture& fixture,
+                                 const std::vector<Eigen::Vector2d>& table_noise,
+                                 const std::vector<ScanReportPoint>& points,
+                                 const std::vector<ScanPointRegion>& regions) {
+  const FixtureErrorModel model(cell, fixture, table_noise);
+  ScanReportEstimator row;
+  row.estimator = fixture.estimator;
+  row.defined = model.defined();
+  if (!row.defined) return row;
+  const Eigen::Matrix3d covariance = model.PoseCovariance();
+  row.sigma = covariance.diagonal().cwiseMax(0).cwiseSqrt();
+  row.sigma.z() *= kDegPerRad;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const ScanReportPoint& point = points[i];
+    const double budget = ScanShare(model.At(point.in_fixture, nullptr, 0)).BudgetMm();
+    if (budget > row.worst_mm || row.worst_at.empty()) {
+      row.worst_mm = budget;
+      row.worst_at = point.name;
+    }
+    if (regions[i].tolerance_mm <= 0) continue;
+    const double share = budget / regions[i].tolerance_mm;
+    if (share > row.worst_share) {
+      row.worst_share = share;
+      row.worst_share_at = fmt::format("{} in region {}", point.name, regions[i].region);
+    }
+  }
+  return row;
+}
+
+// "T1, T4" or "T1..T4" for consecutive trips.
+std::string TripList(const std::vector<std::size_t>& trips) {
+  bool consecutive = trips.size() > 2;
+  for (std::size_t i = 1; i < trips.size(); ++i) consecutive = consecutive && trips[i] == trips[i - 1] + 1;
+  if (consecutive) return fmt::format("{}..{}", TripName(trips.front()), TripName(trips.back()));
+  std::string text;
+  for (std::size_t k : trips) text += (text.empty() ? "" : ", ") + TripName(k);
+  return text;
+}
+
+// A share of the tolerance: "75 %", or "1867x" from ten times up.
+std::string Percent(double share) {
+  return share < 10 ? fmt::format("{:.0f} %", 100 * share) : fmt::format("{:.0f}x", share);
+}
+
+// A copy of `region` with its table (and so its bounds) moved by `move`.
+cell::Region Moved(const cell::Region& region, const Eigen::Vector2d& move) {
+  cell::Region moved = region;
+  for (AxisTable& axis : moved.table.axes) {
+    for (double& x : axis.xs) x += move.x();
+    for (double& y : axis.ys) y += move.y();
+    for (TableNode& check : axis.checks) {
+      check.x_mm += move.x();
+      check.y_mm += move.y();
+    }
+  }
+  moved.domain = TableDomain(moved.table);
+  moved.x_mm = {region.x_mm.lo + move.x(), region.x_mm.hi + move.x()};
+  moved.y_mm = {region.y_mm.lo + move.y(), region.y_mm.hi + move.y()};
+  return moved;
+}
+
+// Changes that take kWorthwhileShareCut or more off the fixture's
+// estimator's worst share of the tolerance, each tried on a copy of the cell:
+// a region under the trips no table calibrates (a copy of the region that
+// calibrates the fixture's other trips, its table moved under them), each
+// other estimator, and the markers and their paths spread farther about S1.
+std::vector<ScanSuggestion> ToleranceSuggestions(const cell::Cell& cell, const cell::Fixture& fixture,
+                                                 const ScanReport& report) {
+  std::vector<ScanSuggestion> out;
+  const ScanReportEstimator* current = nullptr;
+  for (const ScanReportEstimator& e : report.estimators) {
+    if (e.estimator == fixture.estimator) current = &e;
+  }
+  if (current == nullptr || !current->defined || current->worst_share <= 0 || !std::isfinite(current->worst_share)) {
+    return out;
+  }
+  const double before = current->worst_share;
+  auto worth = [&](double after) { return after <= before * (1 - kWorthwhileShareCut); };
+  const std::string tolerance_text = fmt::format("of the tolerance at {}", current->worst_share_at);
+
+  // 1. A table under the trips no table calibrates, one per scan path.
+  const std::vector<int> regions = TripRegions(fixture, cell.regions);
+  const std::vector<TripWindow> windows = TripWindows(fixture);
+  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
+  const cell::Region* model_region = nullptr;  // the region calibrating another trip, else the first with a table
+  for (int r : regions) {
+    if (r >= 0 && model_region == nullptr) model_region = &cell.regions[static_cast<std::size_t>(r)];
+  }
+  for (const cell::Region& region : cell.regions) {
+    if (model_region == nullptr && region.has_table) model_region = &region;
+  }
+  if (model_region != nullptr) {
+    cell::Cell calibrated = cell;
+    std::vector<std::string> where;
+    for (std::size_t p = 0; p < fixture.scan_paths.size(); ++p) {
+      std::vector<std::size_t> trips;
+      Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+      for (std::size_t k = 0; k < expected.size(); ++k) {
+        if (expected[k].path != p || regions[k] >= 0) continue;
+        trips.push_back(k);
+        for (const Eigen::Vector2d& q : {windows[k].from, windows[k].to}) {
+          lo = lo.cwiseMin(q);
+          hi = hi.cwiseMax(q);
+        }
+      }
+      if (trips.empty()) continue;
+      // The model region's table, moved so its domain is centred on the windows.
+      const Rect& domain = model_region->domain;
+      cell::Region added = Moved(*model_region, (lo + hi) / 2 - Eigen::Vector2d((domain.x0 + domain.x1) / 2,
+                                                                                (domain.y0 + domain.y1) / 2));
+      added.name = fmt::format("under scan path '{}'", fixture.scan_paths[p].name);
+      calibrated.regions.push_back(std::move(added));
+      where.push_back(fmt::format("{} of scan path '{}' (x {:.1f}..{:.1f}, y {:.1f}..{:.1f} mm)", TripList(trips),
+                                  fixture.scan_paths[p].name, lo.x(), hi.x(), lo.y(), hi.y()));
+    }
+    if (!where.empty()) {
+      const ScanReportEstimator row = EstimatorRow(calibrated, fixture, RegionTableNoise(calibrated), report.points, report.point_regions);
+      if (row.defined && worth(row.worst_share)) {
+        out.push_back({fmt::format("calibrate a region under {}, as region '{}' is measured: the trips then take the "
+                                   "robot's error from a table instead of up to its uncalibrated accuracy",
+                                   fmt::join(where, " and "), model_region->name),
+                       before, row.worst_share});
+      }
+    }
+  }
+
+  // 2. Another estimator.
+  for (const ScanReportEstimator& e : report.estimators) {
+    if (&e == current || !e.defined || e.worst_share < 0 || !worth(e.worst_share)) continue;
+    out.push_back({fmt::format("estimator = \"{}\"", cell::EstimatorName(e.estimator)), before, e.worst_share});
+  }
+
+  // 3. A longer baseline: the markers and their paths spread about S1 (the
+  // board's points stay), as far as the robot's travel allows; each region
+  // that calibrates trips moved with them.
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  const std::vector<Eigen::Vector2d> trips_now = NominalTrips(fixture, nominal);
+  for (double factor : {2.0, 1.5, 1.25}) {
+    cell::Fixture spread = fixture;
+    spread.l1_mm *= factor;
+    spread.l2_mm *= factor;
+    for (cell::MarkerEdge& edge : spread.edges) {
+      edge.from *= factor;
+      edge.to *= factor;
+    }
+    bool reachable = true;
+    for (cell::ScanPath& path : spread.scan_paths) {
+      for (Eigen::Vector2d& q : path.points) {
+        q *= factor;
+        const Eigen::Vector2d base = ToBase(nominal, q);
+        reachable = reachable && cell.robot.limits[0].Contains(base.x()) && cell.robot.limits[1].Contains(base.y());
+      }
+    }
+    if (!reachable) continue;
+    cell::Cell moved_cell = cell;
+    const std::vector<Eigen::Vector2d> trips_then = NominalTrips(spread, nominal);
+    for (std::size_t r = 0; r < cell.regions.size(); ++r) {
+      Eigen::Vector2d move = Eigen::Vector2d::Zero();
+      int n = 0;
+      for (std::size_t k = 0; k < regions.size(); ++k) {
+        if (regions[k] != static_cast<int>(r)) continue;
+        move += trips_then[k] - trips_now[k];
+        ++n;
+      }
+      if (n > 0) moved_cell.regions[r] = Moved(cell.regions[r], move / n);
+    }
+    const ScanReportEstimator row = EstimatorRow(moved_cell, spread, RegionTableNoise(moved_cell), report.points, report.point_regions);
+    if (row.defined && worth(row.worst_share)) {
+      out.push_back({fmt::format("a longer baseline: the markers and their scan paths {} x as far from S1 (L1 {} mm, "
+                                 "L2 {} mm), still within the robot's travel, with their trips calibrated as now",
+                                 factor, Num(spread.l1_mm), Num(spread.l2_mm)),
+                     before, row.worst_share});
+    }
+    break;  // the longest spread that fits is the one to say
+  }
+  for (ScanSuggestion& s : out) {
+    s.change += fmt::format(": the {} estimator's worst share {} would fall from {} to {}",
+                            cell::EstimatorName(fixture.estimator), tolerance_text, Percent(s.share_before),
+                            Percent(s.share_after));
+  }
+  return out;
+}
+
 }  // namespace
 
 ScanReport MakeScanReport(const cell::Cell& cell, const cell::Fixture& fixture, std::vector<ScanReportPoint> points,
@@ -148,28 +334,27 @@ ScanReport MakeScanReport(const cell::Cell& cell, const cell::Fixture& fixture, 
   report.capture = ScanCaptureRange(fixture);
   report.latency_mm = fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s;
   report.points = points.empty() ? BoardGrid(fixture) : std::move(points);
+  // Each point's region and tolerance, at the fixture's nominal pose; a
+  // region under the trips is where the scan is measured, not a placing
+  // area, and gives no tolerance to share.
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  const std::vector<int> trip_regions = TripRegions(fixture, cell.regions);
+  for (const ScanReportPoint& point : report.points) {
+    const cell::Region* region = cell.RegionAt(ToBase(nominal, point.in_fixture));
+    const bool under_trips =
+        region != nullptr && std::find(trip_regions.begin(), trip_regions.end(),
+                                       static_cast<int>(region - cell.regions.data())) != trip_regions.end();
+    report.point_regions.push_back(region == nullptr || under_trips ? ScanPointRegion{}
+                                                                    : ScanPointRegion{region->name, region->tolerance_mm});
+  }
   const std::vector<Eigen::Vector2d> table_noise = RegionTableNoise(cell);
   for (cell::Estimator estimator : {cell::Estimator::kPaper, cell::Estimator::kRigid, cell::Estimator::kRigidScale}) {
     cell::Fixture variant = fixture;
     variant.estimator = estimator;
-    const FixtureErrorModel model(cell, variant, table_noise);
-    ScanReportEstimator row;
-    row.estimator = estimator;
-    row.defined = model.defined();
-    if (row.defined) {
-      const Eigen::Matrix3d covariance = model.PoseCovariance();
-      row.sigma = covariance.diagonal().cwiseMax(0).cwiseSqrt();
-      row.sigma.z() *= kDegPerRad;
-      for (const ScanReportPoint& point : report.points) {
-        const double budget = ScanShare(model.At(point.in_fixture, nullptr, 0)).BudgetMm();
-        if (budget > row.worst_mm || row.worst_at.empty()) {
-          row.worst_mm = budget;
-          row.worst_at = point.name;
-        }
-      }
-    }
+    const ScanReportEstimator row = EstimatorRow(cell, variant, table_noise, report.points, report.point_regions);
     report.estimators.push_back(row);
     if (estimator != fixture.estimator || !row.defined) continue;
+    const FixtureErrorModel model(cell, variant, table_noise);
     for (const ScanReportPoint& point : report.points) {
       const ErrorShare share = ScanShare(model.At(point.in_fixture, nullptr, 0));
       report.point_mean_mm.push_back(share.mean_mm);
@@ -185,7 +370,12 @@ ScanReport MakeScanReport(const cell::Cell& cell, const cell::Fixture& fixture, 
     const double cosine = std::abs(trip.leg_direction.dot(along.normalized()));
     report.trip_angle_deg.push_back(std::acos(std::clamp(cosine, 0.0, 1.0)) * kDegPerRad);
   }
+  for (int r : TripRegions(fixture, cell.regions)) {
+    report.trip_table.push_back(r < 0 ? std::string() : cell.regions[static_cast<std::size_t>(r)].name);
+  }
   report.suggestions = Suggestions(cell, fixture, report);
+  report.tolerance_suggestions = ToleranceSuggestions(cell, fixture, report);
+  for (const ScanSuggestion& s : report.tolerance_suggestions) report.suggestions.push_back(s.change);
   return report;
 }
 
@@ -212,19 +402,31 @@ std::string ScanReportText(const ScanReport& report) {
                      Num(fixture.max_rotation_deg),
                      c.factor >= 1 ? ": every board the checks accept is measured" : ": SMALLER than the limits");
   if (!c.limited_by.empty()) out += fmt::format("  beyond it: {}\n", c.limited_by);
-  out += "trips (fixture frame): edge, crossing, leg's angle to the edge, distance from the edge's nearer end\n";
+  out += "trips (fixture frame): edge, crossing, leg's angle to the edge, distance from the edge's nearer end, "
+         "the table that calibrates it\n";
+  std::vector<std::size_t> uncalibrated;
   for (std::size_t k = 0; k < expected.size(); ++k) {
-    out += fmt::format("  {:<4} {}  ({}, {})  {} deg  {} mm\n", TripName(k),
+    if (report.trip_table[k].empty()) uncalibrated.push_back(k);
+    out += fmt::format("  {:<4} {}  ({}, {})  {} deg  {} mm  {}\n", TripName(k),
                        fixture.edges[static_cast<std::size_t>(expected[k].edge)].name,
                        Fixed(expected[k].in_fixture.x(), 3), Fixed(expected[k].in_fixture.y(), 3),
-                       Fixed(report.trip_angle_deg[k], 1), Fixed(report.trip_edge_margin_mm[k], 2));
+                       Fixed(report.trip_angle_deg[k], 1), Fixed(report.trip_edge_margin_mm[k], 2),
+                       report.trip_table[k].empty() ? std::string("NONE: outside every table")
+                                                    : "region " + report.trip_table[k]);
+  }
+  if (!uncalibrated.empty()) {
+    out += fmt::format("  {} outside every table: used as commanded, so the robot's own error there is in every "
+                       "estimator's figure below\n",
+                       uncalibrated.size() == 1 ? TripName(uncalibrated.front()) + " lies"
+                                                : TripList(uncalibrated) + " lie");
   }
   out += fmt::format("latency: a trip is latched 0 to {} mm past its edge (the latch feed {} mm/s x the servo "
                      "period)\n",
                      Fixed(report.latency_mm, 4), Num(fixture.TripLatchSpeedMmS()));
   out += "pose per estimator, 1 sigma from the sensor, the repeatability at the trips, the latency and the tables\n"
-         "under the trips; the scan's part of a placement's error at 4 sigma, worst over the points:\n";
-  out += "  estimator     sigma x mm  sigma y mm  sigma angle deg  worst mm  at\n";
+         "under the trips; the scan's part of a placement's error at 4 sigma, worst over the points, and as a\n"
+         "share of the point's tolerance (its region's), worst over the points in a region:\n";
+  out += "  estimator     sigma x mm  sigma y mm  sigma angle deg  worst mm  share  at\n";
   for (const ScanReportEstimator& e : report.estimators) {
     const std::string name =
         fmt::format("{}{}", cell::EstimatorName(e.estimator), e.estimator == fixture.estimator ? " *" : "");
@@ -235,13 +437,37 @@ std::string ScanReportText(const ScanReport& report) {
     // An unbounded source (a trip where no table and no uncalibrated
     // accuracy bounds the robot's error) bounds nothing at any point.
     const bool bounded = std::isfinite(e.worst_mm);
-    out += fmt::format("  {:<13} {:>10}  {:>10}  {:>15}  {:>8}  {}\n", name, Fixed(e.sigma.x(), 4),
+    const bool shared = bounded && e.worst_share >= 0;
+    out += fmt::format("  {:<13} {:>10}  {:>10}  {:>15}  {:>8}  {:>5}  {}\n", name, Fixed(e.sigma.x(), 4),
                        Fixed(e.sigma.y(), 4), Fixed(e.sigma.z(), 5), bounded ? Fixed(e.worst_mm, 4) : "unbounded",
-                       bounded ? e.worst_at : "everywhere (`smtcal verify` names the source)");
+                       shared ? Percent(e.worst_share) : "-",
+                       !bounded  ? std::string("everywhere (`smtcal verify` names the source)")
+                       : shared && e.worst_share_at.find(e.worst_at + " in region") != 0
+                           ? fmt::format("{}; share at {}", e.worst_at, e.worst_share_at)
+                       : shared ? e.worst_share_at
+                                : e.worst_at + " (in no region: no tolerance)");
   }
   out += "  (* the fixture's estimator)\n";
+  // The fixture's estimator at every point in a region: how the shares spread.
+  std::vector<double> shares;
+  for (std::size_t i = 0; i < report.point_budget_mm.size(); ++i) {
+    const double tolerance = report.point_regions[i].tolerance_mm;
+    if (tolerance > 0) shares.push_back(report.point_budget_mm[i] / tolerance);
+  }
+  if (!shares.empty() && std::all_of(shares.begin(), shares.end(), [](double s) { return std::isfinite(s); })) {
+    std::sort(shares.begin(), shares.end());
+    const std::size_t over = static_cast<std::size_t>(std::count_if(shares.begin(), shares.end(), [](double s) { return s > 1; }));
+    out += fmt::format("the {} estimator's share of the tolerance at the {} point{} in a region: {} to {}, half of "
+                       "them above {}{}\n",
+                       cell::EstimatorName(fixture.estimator), shares.size(), shares.size() == 1 ? "" : "s",
+                       Percent(shares.front()), Percent(shares.back()), Percent(shares[shares.size() / 2]),
+                       over == 0 ? std::string()
+                                 : fmt::format("; at {} of them the scan alone takes more than the whole tolerance", over));
+  }
   if (report.suggestions.empty()) {
-    out += "suggestions: none: the layout measures every board the limits accept\n";
+    out += "suggestions: none: the layout measures every board the limits accept, and no change tried (a table "
+           "under the trips, another estimator, a longer baseline) takes 10 % of the scan's worst share of the "
+           "tolerance off\n";
   } else {
     out += "suggestions:\n";
     for (const std::string& s : report.suggestions) out += fmt::format("  - {}\n", s);
@@ -278,7 +504,8 @@ std::string ScanReportJson(const ScanReport& report) {
                             {"x_mm", expected[k].in_fixture.x()},
                             {"y_mm", expected[k].in_fixture.y()},
                             {"angle_to_edge_deg", RoundedToDecimals(report.trip_angle_deg[k], 3)},
-                            {"edge_end_mm", RoundedToDecimals(report.trip_edge_margin_mm[k], 4)}});
+                            {"edge_end_mm", RoundedToDecimals(report.trip_edge_margin_mm[k], 4)},
+                            {"table", report.trip_table[k].empty() ? ordered_json() : ordered_json(report.trip_table[k])}});
   }
   out["estimators"] = ordered_json::array();
   for (const ScanReportEstimator& e : report.estimators) {
@@ -296,17 +523,34 @@ std::string ScanReportJson(const ScanReport& report) {
         row["worst_mm"] = nullptr;  // unbounded
         row["worst_at"] = nullptr;
       }
+      const bool shared = std::isfinite(e.worst_share) && e.worst_share >= 0;
+      row["worst_share_of_tolerance"] = shared ? ordered_json(RoundedToDecimals(e.worst_share, 4)) : ordered_json();
+      row["worst_share_at"] = shared ? ordered_json(e.worst_share_at) : ordered_json();
     }
     out["estimators"].push_back(row);
   }
   out["points"] = ordered_json::array();
   for (std::size_t i = 0; i < report.point_budget_mm.size(); ++i) {
-    out["points"].push_back({{"name", report.points[i].name},
-                             {"x_mm", report.points[i].in_fixture.x()},
-                             {"y_mm", report.points[i].in_fixture.y()},
-                             {"budget_mm", RoundedToDecimals(report.point_budget_mm[i], 6)}});
+    const ScanReportPoint& point = report.points[i];
+    const ScanPointRegion& where = report.point_regions[i];
+    const bool shared = where.tolerance_mm > 0 && std::isfinite(report.point_budget_mm[i]);
+    out["points"].push_back(
+        {{"name", point.name},
+         {"x_mm", point.in_fixture.x()},
+         {"y_mm", point.in_fixture.y()},
+         {"budget_mm", RoundedToDecimals(report.point_budget_mm[i], 6)},
+         {"region", where.region.empty() ? ordered_json() : ordered_json(where.region)},
+         {"tolerance_mm", where.tolerance_mm > 0 ? ordered_json(where.tolerance_mm) : ordered_json()},
+         {"share_of_tolerance",
+          shared ? ordered_json(RoundedToDecimals(report.point_budget_mm[i] / where.tolerance_mm, 4)) : ordered_json()}});
   }
   out["suggestions"] = report.suggestions;
+  out["tolerance_suggestions"] = ordered_json::array();
+  for (const ScanSuggestion& s : report.tolerance_suggestions) {
+    out["tolerance_suggestions"].push_back({{"change", s.change},
+                                            {"worst_share_before", RoundedToDecimals(s.share_before, 4)},
+                                            {"worst_share_after", RoundedToDecimals(s.share_after, 4)}});
+  }
   return JsonText(out);
 }
 

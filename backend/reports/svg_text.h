@@ -1,6 +1,6 @@
 // Text inside the SVG pictures smtcal writes (table plots, diff arrows): file
-// names and point names may hold the characters XML reserves; and the round
-// numbers an axis is ticked at.
+// names and point names may hold the characters XML reserves; the round
+// numbers an axis is ticked at; how many glyphs a text is.
 #pragma once
 
 #include <cmath>
@@ -38,6 +38,14 @@ inline std::string SvgEscape(std::string_view text) {
     i += length;
   }
   return out;
+}
+
+// The characters of a UTF-8 text (µ, Ω count once): how wide a label or a
+// table cell is in glyphs.
+inline std::size_t Utf8Columns(std::string_view text) {
+  std::size_t n = 0;
+  for (char c : text) n += (static_cast<unsigned char>(c) & 0xc0) != 0x80;
+  return n;
 }
 
 // A coordinate of the picture: 2 decimals, never "-0.00".

@@ -20,7 +20,9 @@
 #include <fmt/format.h>
 
 #include "base/field_text.h"
+#include "calibration/fixture_geometry.h"
 #include "calibration/limits.h"
+#include "calibration/region_fit.h"
 #include "calibration/tolerances.h"
 #include "frontend/cad/cad_bottom.h"
 #include "frontend/cad/cad_text.h"
@@ -506,6 +508,56 @@ void CadImporter::ReportUnmapped(const std::vector<const Part*>& unmapped) {
 
 std::size_t CadImporter::FateIndex(const Part& part) const { return static_cast<std::size_t>(&part - parts_.data()); }
 
+double SignedDegrees(double degrees) {
+  double u = std::fmod(degrees, 360.0);
+  if (u <= -180) u += 360;
+  if (u > 180) u -= 360;
+  return u == 0 ? 0.0 : u;
+}
+
+void AddDistinct(std::vector<double>& values, double value) {
+  if (std::none_of(values.begin(), values.end(), [&](double v) { return std::abs(v - value) < 1e-9; })) {
+    values.push_back(value);
+  }
+}
+
+void DescribeSlot(SetupSlot& slot, const cad::FeederTable& feeders, std::size_t feeder, int k) {
+  const cad::FeederSpec& spec = feeders.feeders()[feeder];
+  const cad::LaneDescription description = feeders.Describe(feeder, std::max(k, 1));
+  // The lane's own location, else the feeder's with the lane's row and
+  // column on its pallet.
+  slot.location = description.location;
+  if (!description.lane_location && spec.is_pallet() && spec.pick_points() > 1) {
+    const int index = std::max(k, 1) - 1;
+    slot.location += fmt::format("{}row {} of {}, column {} of {}", slot.location.empty() ? "" : ", ",
+                                 index / spec.columns + 1, spec.rows, index % spec.columns + 1, spec.columns);
+  }
+  slot.tape_width_mm = description.tape_width_mm;
+  slot.tape_pitch_mm = description.tape_pitch_mm;
+  // A [[lane]] that says the lane holds another part than the one placed
+  // from it (a lane an import gave to the next kind of part) describes
+  // another reel: its part number is not this one's.
+  auto differs = [](const std::vector<std::string>& parts, const std::string& declared, bool package) {
+    return !declared.empty() && !parts.empty() && std::none_of(parts.begin(), parts.end(), [&](const std::string& part) {
+      return package ? cad::PackageMatch(declared, part) : cad::GlobMatch(declared, part);
+    });
+  };
+  if (differs(slot.values, description.value, false) || differs(slot.packages, description.package, true)) {
+    const std::string note = fmt::format(
+        "the feeders file says this lane holds {}{}{}: not the part placed from it, so its part number is not given",
+        description.value, description.value.empty() || description.package.empty() ? "" : " ", description.package);
+    slot.note = slot.note.empty() ? note : slot.note + "; " + note;
+    return;
+  }
+  if (!description.part_number.empty() &&
+      std::find(slot.part_numbers.begin(), slot.part_numbers.end(), description.part_number) == slot.part_numbers.end()) {
+    slot.part_numbers.push_back(description.part_number);
+  }
+  // What [[lane]] says it holds, where the parts said nothing.
+  if (slot.values.empty() && !description.value.empty()) slot.values.push_back(description.value);
+  if (slot.packages.empty() && !description.package.empty()) slot.packages.push_back(description.package);
+}
+
 void CadImporter::AddToSetup(SetupSlot& slot, const cad::FeederSpec& feeder, int k, bool is_lane, const Part& part,
                              std::size_t board, const std::string& board_name) {
   if (slot.count == 0) {
@@ -518,6 +570,22 @@ void CadImporter::AddToSetup(SetupSlot& slot, const cad::FeederSpec& feeder, int
     for (double& coordinate : slot.pick) coordinate = Round(coordinate, kCadResolutionMm);
   }
   ++slot.count;
+  if (board == 0) {
+    // The part lies in its tape with its 0° at the pick's u less its offset;
+    // the nozzle turns it to its place (the board's and the fixture's turn
+    // included).
+    const double offset = part.feeder->rotation_offset_deg;
+    AddDistinct(slot.in_tape_deg, Round(SignedDegrees(slot.pick[3] - offset), kCadResolutionDeg));
+    double theta = part.rotation_deg;
+    if (placed_mirror_rotation_) theta = placed_mirror_ == ImportMirror::kX ? 180.0 - theta : -theta;
+    const double fixture_angle = options_.cell_fixture != nullptr ? options_.cell_fixture->angle_deg : 0.0;
+    AddDistinct(slot.turns_deg, Round(SignedDegrees(theta + offset + options_.rotation_deg + fixture_angle - slot.pick[3]),
+                                      kCadResolutionDeg));
+    if (!part.feeder->part_number.empty() && std::find(slot.part_numbers.begin(), slot.part_numbers.end(),
+                                                       part.feeder->part_number) == slot.part_numbers.end()) {
+      slot.part_numbers.push_back(part.feeder->part_number);
+    }
+  }
   // A lane or a single tape gives the same parts to every board: named once.
   // A pocket holds one part of one board.
   if (board == 0 || slot.slot_kind == "pocket") {
@@ -736,6 +804,78 @@ bool CadImporter::PlaceBoard(const std::array<double, 4>& outline, double angle)
   return true;
 }
 
+bool CadImporter::CheckRegions(const std::vector<const Part*>& parts,
+                               const std::vector<std::array<double, 2>>& on_board,
+                               const std::vector<std::array<double, 3>>& board_frames,
+                               const std::array<double, 4>& outline) {
+  // A cell with no calibrated region yet (being calibrated, or a test's)
+  // has nothing to hold the parts to: verify will say so.
+  if (options_.cell == nullptr || options_.cell_fixture == nullptr || parts.empty() || options_.cell->regions.empty()) {
+    return true;
+  }
+  const cell::Cell& cell = *options_.cell;
+  const Eigen::Affine3d nominal = NominalFix(*options_.cell_fixture);
+  std::vector<Eigen::Vector2d> placed;  // robot base frame, every part of every board
+  std::vector<std::string> outside;     // designators (with the board of a panel)
+  const Part* first_outside = nullptr;
+  const bool panel = board_frames.size() > 1;
+  for (std::size_t b = 0; b < board_frames.size(); ++b) {
+    const auto [bx, by, rotation] = board_frames[b];
+    const double angle = rotation * std::numbers::pi / 180.0, c = std::cos(angle), s = std::sin(angle);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const auto [x, y] = on_board[i];
+      const Eigen::Vector2d base = ToBase(nominal, {bx + c * x - s * y, by + s * x + c * y});
+      placed.push_back(base);
+      if (cell.RegionAt(base) != nullptr) continue;
+      if (first_outside == nullptr) first_outside = parts[i];
+      outside.push_back(panel ? fmt::format("{} on board {}", Printable(parts[i]->designator), b + 1)
+                              : Printable(parts[i]->designator));
+    }
+  }
+  if (outside.empty()) return true;
+  const RegionFit fit = FitInRegion(cell, placed);
+  std::string names;
+  for (std::size_t k = 0; k < outside.size() && k < 5; ++k) names += (k == 0 ? "" : ", ") + outside[k];
+  if (outside.size() > 5) names += fmt::format(" and {} more", outside.size() - 5);
+  std::string region_text, advice;
+  if (fit.region == nullptr) {
+    region_text = "no calibrated region lies under them";
+    advice = "give --origin X,Y to put the board on a region (docs/import.md, \"Where the board is\")";
+  } else {
+    const cell::Region& region = *fit.region;
+    const double rw = region.x_mm.hi - region.x_mm.lo, rh = region.y_mm.hi - region.y_mm.lo;
+    region_text = fmt::format("region '{}' spans x {}..{}, y {}..{} mm ({} x {} mm)", Printable(region.name),
+                              FormatLength(region.x_mm.lo), FormatLength(region.x_mm.hi), FormatLength(region.y_mm.lo),
+                              FormatLength(region.y_mm.hi), FormatLength(rw), FormatLength(rh));
+    if (fit.larger()) {
+      std::vector<std::string> over;
+      if (fit.width() > rw + kRegionFitSlackMm) over.push_back(fmt::format("{} mm wider", FormatLength(fit.width() - rw)));
+      if (fit.height() > rh + kRegionFitSlackMm) over.push_back(fmt::format("{} mm taller", FormatLength(fit.height() - rh)));
+      advice = fmt::format("the parts are {} than the region, so no --origin fits: place fewer of them (--side, "
+                           "--exclude-designator), or calibrate a larger region",
+                           fmt::join(over, " and "));
+    } else {
+      // The move that centres the parts on the region, in the fixture frame.
+      const Eigen::Vector2d move = nominal.linear().topLeftCorner<2, 2>().transpose() * fit.CentringMove();
+      const double room_x = (rw - fit.width()) / 2, room_y = (rh - fit.height()) / 2;
+      const double shift = options_.cell_fixture->max_shift_mm;
+      advice = fmt::format("--origin {},{} centres them on it, {} mm from its edges in x and {} mm in y{}",
+                           FormatLength(options_.origin_x_mm + move.x()), FormatLength(options_.origin_y_mm + move.y()),
+                           FormatLength(room_x), FormatLength(room_y),
+                           std::min(room_x, room_y) < shift
+                               ? fmt::format(" (less than the {} mm fixture {} may shift: verify says which parts "
+                                             "then leave the region)",
+                                             FormatLength(shift), options_.fixture)
+                               : std::string());
+    }
+  }
+  diags_.Report(DiagKind::ImportBoardOverRegion, first_outside->designator_range, outside.size(),
+                panel ? "panel" : "board", placed.size(), outside.size() == 1 ? "lands" : "land", names, FormatLength(fit.x_lo), FormatLength(fit.x_hi),
+                FormatLength(fit.y_lo), FormatLength(fit.y_hi), FormatLength(fit.width()), FormatLength(fit.height()),
+                FormatLength(outline[2] - outline[0]), FormatLength(outline[3] - outline[1]), region_text, advice);
+  return false;
+}
+
 std::vector<std::unordered_map<std::size_t, int>> CadImporter::AssignTapeLanes(
     const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder) {
   const std::vector<cad::FeederSpec>& feeders = feeders_.feeders();
@@ -746,22 +886,19 @@ std::vector<std::unordered_map<std::size_t, int>> CadImporter::AssignTapeLanes(
     // One kind of part (package and value) per tape, lanes in the order the
     // kinds first appear in the list; a lane a [[map]] gives is kept.
     std::map<std::pair<std::string, std::string>, int> lanes;
-    const Part* first = nullptr;
+    // A single tape: every kind it is given, with its parts, for one warning.
+    std::vector<std::vector<const Part*>> kinds;
     for (std::size_t i : by_feeder[f]) {
       const Part& part = *parts[i];
       if (part.feeder->lane) continue;
       auto [it, fresh] = lanes.emplace(std::make_pair(part.package, part.value), static_cast<int>(lanes.size()) + 1);
-      if (first == nullptr) first = &part;
-      if (!fresh) {
-        if (feeder.is_pallet()) lane_of[f][i] = it->second;
+      if (!feeder.is_pallet()) {
+        if (fresh) kinds.emplace_back();
+        kinds[static_cast<std::size_t>(it->second - 1)].push_back(&part);
         continue;
       }
-      if (!feeder.is_pallet()) {
-        if (it->second == 2) {
-          diags_.Report(DiagKind::ImportTapeMixedKinds, part.designator_range, Printable(feeder.name),
-                        Quoted(part.package), Quoted(part.value), Printable(first->designator),
-                        Quoted(first->package), Quoted(first->value));
-        }
+      if (!fresh) {
+        lane_of[f][i] = it->second;
         continue;
       }
       if (it->second == feeder.pick_points() + 1) {
@@ -769,6 +906,22 @@ std::vector<std::unordered_map<std::size_t, int>> CadImporter::AssignTapeLanes(
                       feeder.pick_points(), Quoted(part.package), Quoted(part.value), it->second);
       }
       lane_of[f][i] = it->second;
+    }
+    if (kinds.size() < 2) continue;
+    // One warning at the first part of the second kind, a note per kind.
+    Diagnostic* diag = diags_.Report(DiagKind::ImportTapeMixedKinds, kinds[1].front()->designator_range,
+                                     Printable(feeder.name), kinds.size());
+    for (std::size_t k = 0; k < kinds.size(); ++k) {
+      const std::vector<const Part*>& of_kind = kinds[k];
+      std::string names;
+      for (std::size_t j = 0; j < of_kind.size() && j < 4; ++j) {
+        names += (j == 0 ? "" : ", ") + Printable(of_kind[j]->designator);
+      }
+      if (of_kind.size() > 4) names += fmt::format(" and {} more", of_kind.size() - 4);
+      Diagnostics::AddNote(diag, of_kind.front()->designator_range,
+                           fmt::format("kind {} of {}: package {}, value {}: {} ({} part{})", k + 1, kinds.size(),
+                                       Quoted(of_kind.front()->package), Quoted(of_kind.front()->value), names,
+                                       of_kind.size(), of_kind.size() == 1 ? "" : "s"));
     }
   }
   return lane_of;
@@ -797,6 +950,8 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   const ImportMirror mirror = options_.mirror.value_or(side == cad::Side::kBottom ? ImportMirror::kX : ImportMirror::kNone);
   const bool mirror_rotation =
       mirror != ImportMirror::kNone && !(side == cad::Side::kBottom && options_.bottom_rotation == BottomRotation::kBottomView);
+  placed_mirror_ = mirror;
+  placed_mirror_rotation_ = mirror_rotation;
   const bool list_negated = side == cad::Side::kBottom && bottom_positions == cad::BottomPositions::kNegatedX;
   std::vector<std::array<double, 2>> on_board(parts.size());
   const std::array<double, 4> outline = Outline(bottom_positions);  // seen from the top
@@ -837,6 +992,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
   summary_.origin_x_mm = options_.origin_x_mm;
   summary_.origin_y_mm = options_.origin_y_mm;
   std::vector<std::string> boards;
+  std::vector<std::array<double, 3>> board_frames;  // x, y, rotation of each board in the fixture
   std::string board_text = fmt::format("origin ({}, {}) mm, rotated {}°", options_.origin_x_mm, options_.origin_y_mm,
                                        options_.rotation_deg);
   if (!options_.origin_given && options_.pocket) {
@@ -857,6 +1013,7 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       double x = Round(options_.origin_x_mm + std::cos(angle) * dx - std::sin(angle) * dy, kCadResolutionMm);
       double y = Round(options_.origin_y_mm + std::sin(angle) * dx + std::cos(angle) * dy, kCadResolutionMm);
       std::string name = names.Claim(panel ? fmt::format("Pcb{}", boards.size() + 1) : "Pcb", {"a board frame", {}, 0});
+      board_frames.push_back({x, y, Round(options_.rotation_deg, kCadResolutionDeg)});
       ir::LocalDecl local{name, start, MakeCoords(start, {x, y, 0.0, Round(options_.rotation_deg, kCadResolutionDeg)}),
                           options_.fixture, start};
       items.push_back(MakeStmt(start, std::move(local),
@@ -864,6 +1021,8 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
       boards.push_back(name);
     }
   }
+
+  if (!CheckRegions(parts, on_board, board_frames, outline)) return std::nullopt;
 
   // --- the feeders the parts use, in the feeder table's order ------------
   std::vector<std::vector<std::size_t>> by_feeder(feeders.size());  // indices into parts
@@ -1022,7 +1181,10 @@ std::optional<ir::Program> CadImporter::Build(const std::vector<const Part*>& pa
         cycle.body.push_back(MakeStmt(loc, std::move(place), comments[i]));
       }
     }
-    for (auto& [k, slot] : slots) setup_.slots.push_back(std::move(slot));
+    for (auto& [k, slot] : slots) {
+      DescribeSlot(slot, feeders_, f, k);
+      setup_.slots.push_back(std::move(slot));
+    }
   }
   ir::Function main;
   main.name = "Main";

@@ -78,6 +78,13 @@ struct ImportOptions {
   SourceRange pocket_range;  // the pocket's keys in the cell
   std::optional<std::array<double, 2>> centre_spot;
   std::string centre_spot_name;  // "region 'layer1'", for the program and the summary
+  // The cell and the fixture the board is on (the fixture's nominal pose):
+  // when the cell has calibrated regions, every part as placed must land in
+  // one, or the import stops before it writes anything
+  // (ImportBoardOverRegion names the parts' and the region's extents and
+  // the --origin that centres them on it). Null: not checked.
+  const cell::Cell* cell = nullptr;
+  const cell::Fixture* cell_fixture = nullptr;
   double rotation_deg = 0;  // the board's x axis against the fixture's
   int columns = 1;          // panel
   int rows = 1;
@@ -143,17 +150,48 @@ struct SetupSlot {
   // What it holds: from the list (import: the distinct ones, in order of
   // appearance), or from the cell's feeder (a program: its package(s), the
   // lane's own on a bank with one package per lane, and its value).
+  // The parts' own (the list's, a program's comments) first, then what the
+  // feeders file's [[lane]] declares, then the feeder's own patterns.
   std::vector<std::string> values, packages;
+  std::vector<std::string> part_numbers;  // a [[map]]'s, [[lane]]'s or the feeder's
+  // Where the operator finds it: declared (`location`), else its row and
+  // column on a pallet ("row 1 of 2, column 3 of 8"); "" for a single pick point.
+  std::string location;
+  std::optional<double> tape_width_mm, tape_pitch_mm;  // declared
+  // Which way the part lies in the tape or pocket: the direction of its 0°
+  // (as its CAD footprint draws it) in the robot base frame, degrees = the
+  // pick's u less the rotation offset it is placed with; one per offset met.
+  std::vector<double> in_tape_deg;
+  // How far the nozzle turns the parts between pick and place (degrees,
+  // (-180, 180]), each value once, in the order met.
+  std::vector<double> turns_deg;
   std::size_t count = 0;  // picks per cycle (all boards of a panel)
   std::string note;       // why a row is special ("" for most)
 };
 struct SetupSheet {
   std::string program;  // the program's name
   std::string fixture;  // the fixture(s) its cycles are on
-  std::size_t boards = 1;
+  std::size_t boards = 1;  // boards a cycle places (a panel's)
   std::string from;     // what the counts are of: "" for an import
   std::vector<SetupSlot> slots;  // feeder by feeder in the feeder order, slots ascending
+  // The lot (--boards N): its boards (0: per cycle only), and the spares to
+  // add to each slot's parts, a share of them rounded up (--spares).
+  std::size_t lot_boards = 0;
+  double spares_percent = 0;
+  // Cycles the lot takes: its boards over the boards a cycle places, rounded up.
+  std::size_t LotCycles() const { return boards == 0 ? 0 : (lot_boards + boards - 1) / boards; }
 };
+
+// A slot's description for the set-up sheet, from the feeders file and the
+// feeder's geometry: its location, part number and tape (DescribeSlot
+// leaves values, packages and counts alone). `k` is the pick point (0 or 1
+// for a single one).
+void DescribeSlot(SetupSlot& slot, const cad::FeederTable& feeders, std::size_t feeder, int k);
+
+// An angle in degrees normalised into (-180, 180].
+double SignedDegrees(double degrees);
+// Adds `value` to `values` unless it is there (to 1e-9).
+void AddDistinct(std::vector<double>& values, double value);
 
 struct ImportSummary {
   std::size_t rows_read = 0;
@@ -249,6 +287,11 @@ class CadImporter {
   // the bottom side): into the pocket, or its centre on the centre spot.
   // False after reporting a board that does not fit its pocket.
   bool PlaceBoard(const std::array<double, 4>& on_board_outline, double angle);
+  // Reports the parts (on_board: each part's board coordinates; board_frames:
+  // each board's x, y, rotation in the fixture) that land outside every
+  // calibrated region; false when any does.
+  bool CheckRegions(const std::vector<const Part*>& parts, const std::vector<std::array<double, 2>>& on_board,
+                    const std::vector<std::array<double, 3>>& board_frames, const std::array<double, 4>& outline);
   std::vector<std::unordered_map<std::size_t, int>> AssignTapeLanes(
       const std::vector<const Part*>& parts, const std::vector<std::vector<std::size_t>>& by_feeder);
   std::optional<ir::Program> Build(const std::vector<const Part*>& parts, cad::Side side,
@@ -269,6 +312,9 @@ class CadImporter {
   std::vector<RowFate> fates_;
   SetupSheet setup_;
   ImportSummary summary_;
+  // How Build turns the placed side's rotations (for the set-up sheet's turns).
+  ImportMirror placed_mirror_ = ImportMirror::kNone;
+  bool placed_mirror_rotation_ = false;
 };
 
 // A name for the .place language from any text: letters, digits and '_'
