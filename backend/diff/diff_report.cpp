@@ -180,16 +180,21 @@ std::string MachineHeader(const ProgramDiff& diff) {
   text += diff.tables_differ.empty()
               ? std::string("the cells hold the same tables and fixtures\n")
               : fmt::format("the cells differ in: {}\n", fmt::join(diff.tables_differ, ", "));
-  text += "on the machine: each program through its own cell, the robot moving as NEW's cell says";
+  text += fmt::format(
+      "on the machine: one robot and one board, as {0}'s cell describes them (--machine {1}); each program with its "
+      "own cell's tables, marker geometry, estimator, scan paths and limits",
+      diff.machine, diff.machine == "NEW" ? "new" : "old");
   if (diff.poses > 1) {
     text += fmt::format(
-        "; board targets at {} poses within the fixtures' check limits, as far out as the robot's scan accepts",
+        "; board targets at {} poses within the fixtures' check limits, as far out as both programs' scans accept",
         diff.poses);
   }
   if (!diff.refused_poses.empty()) {
     text += fmt::format(" ({} refused by both programs' scans: not compared)", fmt::join(diff.refused_poses, ", "));
   }
-  return text + "\n";
+  text += "\n";
+  for (const std::string& acceptance : diff.acceptance) text += "accepted boards: " + acceptance + "\n";
+  return text;
 }
 
 }  // namespace
@@ -294,8 +299,11 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
   if (diff.on_machine) {
     ordered_json differ = ordered_json::array();
     for (const std::string& what : diff.tables_differ) differ.push_back(what);
+    ordered_json acceptance = ordered_json::array();
+    for (const std::string& what : diff.acceptance) acceptance.push_back(what);
     root["cells"] = {{"old", JsonCell(*diff.old_cell)}, {"new", JsonCell(*diff.new_cell)}, {"differ", differ},
-                     {"poses", diff.poses}};
+                     {"machine", diff.machine == "NEW" ? "new" : "old"}, {"poses", diff.poses},
+                     {"acceptance", acceptance}};
   } else {
     root["cells"] = ordered_json();
   }

@@ -158,8 +158,13 @@ struct ProgramDiff {
   bool on_machine = false;
   std::optional<DiffSideCell> old_cell, new_cell;
   std::vector<std::string> tables_differ;  // "region layer1" for each region whose tables differ
+  // Whose cell describes the machine (the robot and the boards): "NEW" or "OLD".
+  std::string machine = "NEW";
   std::size_t poses = 0;                    // board poses evaluated per fixture
   std::vector<std::string> refused_poses;   // "6 of Board's poses": both programs' scans refuse them
+  // Per board whose programs' scans accept different poses: how (the poses
+  // evaluated are the ones both accept; not gated).
+  std::vector<std::string> acceptance;
   std::vector<MatchedStatement> matched;    // motion statements in both, in NEW's order
   // Targets compared: point declarations; motion statements as text; their
   // positions on the machine (Summary::targets_compared takes the first and
@@ -199,11 +204,14 @@ struct MachineSide {
 };
 // The comparison on the machine (docs/diff.md, "On the machine"): every
 // position of every matched motion statement, each program through its own
-// cell, the robot as NEW's cell describes it, at the nominal pose and the
-// poses of calibration/machine_model.h. Adds the moves to `diff` (a change
-// for a statement whose text did not change but whose positions moved) and
-// summarizes it again. `diff.matched`'s statements must still be alive.
-void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side);
+// cell's constants on ONE machine (calibration/machine_model.h: the robot
+// and the boards of NEW's cell, or OLD's with `old_is_machine`), at the
+// nominal pose and the poses both programs' scans accept out to the check
+// limits. Adds the moves to `diff` (a change for a statement whose text did
+// not change but whose positions moved) and summarizes it again.
+// `diff.matched`'s statements must still be alive.
+void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side,
+                      bool old_is_machine = false);
 
 // ------------------------------------------------------------------ matching
 // Exposed for the unit tests.
