@@ -38,6 +38,7 @@ struct DiffCommandOptions {
   bool json = false;
   std::string svg_path;
   bool exit_zero = false;
+  std::string machine = "new";  // whose cell describes the machine: new | old
 };
 
 // Parses a program and runs the semantic checks, like `smtcal check`.
@@ -323,7 +324,7 @@ void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
       return;
     }
     diff::CompareOnMachine(result, {old_side.cell, &old_side.targets, old_side.described},
-                           {new_side.cell, &new_side.targets, new_side.described});
+                           {new_side.cell, &new_side.targets, new_side.described}, opt.machine == "old");
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (options.exit_code != kExitOk) return;
@@ -366,6 +367,12 @@ void AddDiffCommand(CLI::App& app, GlobalOptions& options) {
   diff->add_option("--new-cell", opt.new_cell_path, "the cell NEW was compiled for (when it is not OLD's)");
   AddNumberOption(*diff, "--threshold", opt.threshold_um, "the gate: a target that moved by more than this many µm fails it",
                   limits::kDiffThresholdUm)
+      ->capture_default_str();
+  diff->add_option("--machine", opt.machine,
+                   "whose cell describes the machine both programs run on, the robot (its tables) and the boards "
+                   "(their marker edges): new (the latest description of the real cell) or old; each program brings "
+                   "its own cell's tables, marker geometry, estimator, scan paths and limits")
+      ->check(CLI::IsMember({"new", "old"}))
       ->capture_default_str();
   diff->add_flag("--json", opt.json, "print the diff as JSON (schema in docs/diff.md) instead of text");
   diff->add_option("--svg", opt.svg_path,
