@@ -170,7 +170,10 @@ std::optional<ReadError> FirstDifference(const SourceFile& file, std::string_vie
         if (x && y && std::fabs(*x - *y) <= kRoundingRel * std::max({1.0, std::fabs(*x), std::fabs(*y)})) continue;
       }
     }
-    return ReadError{have[i].first, fmt::format("smtcal writes '{}' here", Shown(want[i]))};
+    return ReadError{have[i].first, fmt::format("smtcal writes '{}' here{}", Shown(want[i]),
+                                                rounding ? " for the data as read: this line or one it is "
+                                                           "computed from was changed"
+                                                         : "")};
   }
   return std::nullopt;
 }
@@ -849,6 +852,8 @@ class Decompiler {
   // writes it for that wiring (LinuxCncPickPlaceSubroutine).
   void PickPlaceSubroutine() {
     const NgcLine& first = Peek();
+    constexpr int kMaxSubroutineLines = 40;
+    int read = 0;
     std::string text;
     std::string where;
     while (true) {
@@ -888,14 +893,17 @@ class Decompiler {
         if (end == std::string::npos) Fail(line, "o<pick_place>'s abort is not smtcal's");
         where = c.substr(22, end - 22);
       }
-      if (b == "o<pick_place> endsub") break;
+      // Its end, or as far as the longest the emitter writes: the comparison
+      // names the first line that differs.
+      if (b.starts_with("o<pick_place> endsub") || ++read > kMaxSubroutineLines) break;
     }
-    if (!wiring_.vacuum_sensor || !wiring_.axis || where.empty()) Fail(first, "an o<pick_place> that is not smtcal's");
+    // What it names is compared whole below: a line it could not be read
+    // from is the first that differs from the emitter's.
     cell::Cell wired;
     wired.linuxcnc.emplace();
-    wired.linuxcnc->rotation_axis = *wiring_.axis;
-    wired.linuxcnc->vacuum_sensor_input = *wiring_.vacuum_sensor;
-    wired.linuxcnc->vacuum_timeout_s = *wiring_.vacuum_timeout_s;
+    wired.linuxcnc->rotation_axis = wiring_.axis.value_or('C');
+    wired.linuxcnc->vacuum_sensor_input = wiring_.vacuum_sensor.value_or(0);
+    wired.linuxcnc->vacuum_timeout_s = wiring_.vacuum_timeout_s.value_or(1);
     wired.robot.final_approach_mm = wiring_.approach;
     if (std::optional<ReadError> differs = FirstDifferenceIn(first.number, text,
                                                               LinuxCncPickPlaceSubroutine(wired, where))) {
