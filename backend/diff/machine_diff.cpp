@@ -213,6 +213,12 @@ class MachineComparer {
 
   // Fills `move`; true when it is worth reporting (moved or not comparable).
   bool ComparePosition(const MachineTarget& a, const MachineTarget& b, MachineMove& move) {
+    // Where the picture draws it when it cannot be compared: where NEW's
+    // program puts it with the board at its nominal pose.
+    if (b.known || a.known) {
+      move.required = b.known ? NominalPlace(b, *new_.cell) : NominalPlace(a, *old_.cell);
+      move.located = true;
+    }
     if (!a.known || !b.known) {
       // The same unknown position under the same tables moves nothing.
       if (!a.known && !b.known && same_cells_ && a.kind == b.kind && a.fixture == b.fixture) return false;
@@ -263,8 +269,8 @@ class MachineComparer {
         if (old_refused || new_refused) {
           move.comparable = false;
           move.note = fmt::format("with {} {} {}'s scan refuses the board ({}) and {}'s does not", move.board,
-                                  DescribeBoardPose((*pose_list)[p]), old_refused ? "OLD" : "NEW",
-                                  old_refused ? old_why : new_why, old_refused ? "NEW" : "OLD");
+                                  AtPose((*pose_list)[p]), old_refused ? "OLD" : "NEW", old_refused ? old_why : new_why,
+                                  old_refused ? "NEW" : "OLD");
           return true;
         }
       }
@@ -275,9 +281,8 @@ class MachineComparer {
       if (!old_at.ok && !new_at.ok) continue;
       if (!old_at.ok || !new_at.ok) {
         move.comparable = false;
-        const std::string where = pose_list != nullptr ? fmt::format(" with {} {}", move.board,
-                                                                     DescribeBoardPose((*pose_list)[p]))
-                                                       : "";
+        const std::string where =
+            pose_list != nullptr ? fmt::format(" with {} {}", move.board, AtPose((*pose_list)[p])) : "";
         move.note = !old_at.ok ? fmt::format("OLD commands nothing{}: {}", where, old_at.why)
                                : fmt::format("NEW commands nothing{}: {}", where, new_at.why);
         return true;
@@ -355,6 +360,11 @@ class MachineComparer {
         b[widest] == 0 ? "none" : DescribeBoardPose(ScaledPose(limits[widest], b[widest]))));
   }
 
+  // "at its nominal pose", "shifted 1.980 mm toward 0°": after "with Board".
+  static std::string AtPose(const BoardPose& pose) {
+    return pose.nominal() ? std::string("at its nominal pose") : DescribeBoardPose(pose);
+  }
+
   // Whether `model`'s controller refuses the scan of `board` at pose `p`
   // (false when its cell has no such fixture: its program scans none).
   static bool Refuses(const MachineModel& model, const std::string& board, std::size_t p, std::string& why) {
@@ -364,16 +374,21 @@ class MachineComparer {
     return !model.ScanFix(index, p, &why).has_value();
   }
 
-  // An unmoved position in the picture: where NEW wants it at the nominal pose.
-  void Unchanged(const MachineTarget& target) {
-    if (!target.known) return;
+  // A position in the base frame with its board at the nominal pose `cell` gives it.
+  static Pose4 NominalPlace(const MachineTarget& target, const cell::Cell& cell) {
     Pose4 at = target.position;
     if (target.kind == MachineTarget::Kind::kFixture) {
-      const cell::Fixture& fixture = new_.cell->fixtures[static_cast<std::size_t>(target.fixture)];
+      const cell::Fixture& fixture = cell.fixtures[static_cast<std::size_t>(target.fixture)];
       const Eigen::Vector2d base = ToBase(NominalFix(fixture), {at[0], at[1]});
       at = {base.x(), base.y(), at[2], at[3] + fixture.angle_deg};
     }
-    diff_.unchanged_plot.push_back(at);
+    return at;
+  }
+
+  // An unmoved position in the picture: where NEW wants it at the nominal pose.
+  void Unchanged(const MachineTarget& target) {
+    if (!target.known) return;
+    diff_.unchanged_plot.push_back(NominalPlace(target, *new_.cell));
     diff_.unchanged_plot_frame.push_back("robot base");
     diff_.unchanged_plot_statement.push_back(true);
   }

@@ -51,8 +51,11 @@ enum class ChangeKind {
   kChanged,  // something other than coordinates changed (possibly also moved)
   kAdded,    // only in NEW
   kRemoved,  // only in OLD
+  // The same line (the same position) in both, at another place in its
+  // function's sequence: a change of sequence, not a move.
+  kReordered,
 };
-std::string_view ChangeKindName(ChangeKind kind);  // moved | changed | added | removed
+std::string_view ChangeKindName(ChangeKind kind);  // moved | changed | added | removed | reordered
 
 // One position a matched motion statement commands, compared on the machine
 // (docs/diff.md, "On the machine"): each program through its own cell, on a
@@ -63,6 +66,7 @@ struct MachineMove {
   std::string board;      // the fixture whose poses it was evaluated at ("" for a base target)
   std::string region;     // the region that corrects it at the nominal pose, in NEW ("" none)
   Pose4 required{};       // where NEW wants the part at the nominal pose (base frame)
+  bool located = false;   // `required` holds it (not for a position known only at run time)
   bool comparable = true;  // false: note says why (the scan refuses a pose, a point the tables refuse, ...)
   std::string note;
   Displacement command;   // the command's move at the nominal pose, in the robot base frame
@@ -115,15 +119,17 @@ struct Summary {
   std::size_t beyond_threshold = 0;  // moved by more than the threshold
   std::size_t not_comparable = 0;    // matched targets whose positions cannot be compared
   std::size_t added = 0, removed = 0, changed = 0;  // statements and declarations
+  std::size_t reordered = 0;                        // statements the same, in another order
   std::size_t largest = 0;           // index into ProgramDiff::changes; valid when largest_um > 0
   double largest_um = 0;
   std::size_t largest_position = 0;  // on the machine: the index into changes[largest].machine
   std::size_t points_moved_in_text = 0;  // on the machine: point declarations whose coordinates moved (not gated)
-  // The deployment gate (docs/diff.md): passes when nothing was added or
-  // removed, nothing changed other than coordinates, no move could not be
-  // compared, and no target moved by more than the threshold.
+  // The deployment gate (docs/diff.md): passes when nothing was added,
+  // removed or reordered, nothing changed other than coordinates, no move
+  // could not be compared, and no target moved by more than the threshold.
   bool gate_passes() const {
-    return beyond_threshold == 0 && added == 0 && removed == 0 && changed == 0 && not_comparable == 0;
+    return beyond_threshold == 0 && added == 0 && removed == 0 && changed == 0 && reordered == 0 &&
+           not_comparable == 0;
   }
 };
 
