@@ -881,16 +881,8 @@ class Differ {
     Change change = Make(ChangeKind::kReordered, &a, &b, function);
     change.note = "the same, in another order";
     if (a.branch <= 0 && ir::MotionTarget(*a.stmt) != nullptr && ir::MotionTarget(*b.stmt) != nullptr) {
-      MatchedStatement matched;
-      matched.old_stmt = a.stmt;
-      matched.new_stmt = b.stmt;
-      matched.old_loc = change.old_side.loc;
-      matched.new_loc = change.new_side.loc;
-      matched.text = b.text;
-      matched.function = function;
-      matched.insert_at = diff_.changes.size();
-      matched.change = diff_.changes.size();
-      diff_.matched.push_back(std::move(matched));
+      RememberMatched(a, b, change, function);
+      diff_.matched.back().change = diff_.changes.size();
       ++diff_.statements_compared;
     }
     if (a.placement && b.placement && a.placement->known && b.placement->known && a.placement->symbolic.empty()) {
@@ -899,6 +891,20 @@ class Differ {
       change.new_plot = comparer_.PlotPose(*b.placement);
     }
     diff_.changes.push_back(std::move(change));
+  }
+
+  // A matched motion statement, remembered for CompareOnMachine; its change
+  // (if any) is the next one pushed.
+  void RememberMatched(const Item& a, const Item& b, const Change& change, const std::string& function) {
+    MatchedStatement matched;
+    matched.old_stmt = a.stmt;
+    matched.new_stmt = b.stmt;
+    matched.old_loc = change.old_side.loc;
+    matched.new_loc = change.new_side.loc;
+    matched.text = b.text;
+    matched.function = function;
+    matched.insert_at = diff_.changes.size();
+    diff_.matched.push_back(std::move(matched));
   }
 
   // ---------------------------------------------------------------- changes
@@ -943,17 +949,7 @@ class Differ {
     bool moved = false;
     // A motion statement may move on the machine whatever its text says: remembered for CompareOnMachine.
     const bool motion = a.branch <= 0 && ir::MotionTarget(*a.stmt) != nullptr && ir::MotionTarget(*b.stmt) != nullptr;
-    if (motion) {
-      MatchedStatement matched;
-      matched.old_stmt = a.stmt;
-      matched.new_stmt = b.stmt;
-      matched.old_loc = change.old_side.loc;
-      matched.new_loc = change.new_side.loc;
-      matched.text = b.text;
-      matched.function = function;
-      matched.insert_at = diff_.changes.size();
-      diff_.matched.push_back(std::move(matched));
-    }
+    if (motion) RememberMatched(a, b, change, function);
     // Pushes the change, remembering it for the matched statement.
     auto push = [&](Change&& made) {
       if (motion) diff_.matched.back().change = diff_.changes.size();

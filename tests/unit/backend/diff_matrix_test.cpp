@@ -300,17 +300,6 @@ void Trace(const fs::path& program, const fs::path& cell_path, Traced& out) {
   ASSERT_FALSE(out.diags->has_errors()) << program;
 }
 
-// The motion statements of a program, in order.
-std::vector<const ir::Stmt*> Motions(const ir::Program& program) {
-  std::vector<const ir::Stmt*> motions;
-  ir::ForEachStmt(program.items, [&](const ir::Stmt& stmt) {
-    if (std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node)) {
-      motions.push_back(&stmt);
-    }
-  });
-  return motions;
-}
-
 // Every position's move by the second model: (NEW's line, position index)
 // -> (the landing's move at the nominal pose, the worst of command and
 // landing over the poses), in µm; nullopt where one program commands nothing.
@@ -332,7 +321,7 @@ std::map<std::pair<std::uint32_t, std::size_t>, SecondMove> SecondModel(const Tr
     old_fix.push_back(old_program.Scan(0, pose));
     new_fix.push_back(new_program.Scan(0, pose));
   }
-  const std::vector<const ir::Stmt*> a = Motions(old_side.program), b = Motions(new_side.program);
+  const std::vector<const ir::Stmt*> a = test::Motions(old_side.program), b = test::Motions(new_side.program);
   EXPECT_EQ(a.size(), b.size());
   for (std::size_t s = 0; s < std::min(a.size(), b.size()); ++s) {
     const std::span<const MachineTarget> pa = old_side.targets.Of(a[s]), pb = new_side.targets.Of(b[s]);

@@ -72,16 +72,6 @@ ir::Program ParseAndCheck(std::uint32_t file, Diagnostics& diags) {
   return program;
 }
 
-std::vector<const ir::Stmt*> Motions(const ir::Program& program) {
-  std::vector<const ir::Stmt*> motions;
-  ir::ForEachStmt(program.items, [&](const ir::Stmt& stmt) {
-    if (std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node)) {
-      motions.push_back(&stmt);
-    }
-  });
-  return motions;
-}
-
 // A program compiled for the example cell, its LinuxCNC output in `sources`.
 struct Emitted {
   ir::Program program;
@@ -152,7 +142,7 @@ MachineTargets TraceRead(const LinuxCncOutputRead& read, ir::Program& program, D
 // position to the 10 decimals a program's text holds).
 void ExpectSamePlan(const ir::Program& a, const MachineTargets& plan_a, const ir::Program& b,
                     const MachineTargets& plan_b, const std::string& what) {
-  const std::vector<const ir::Stmt*> sa = Motions(a), sb = Motions(b);
+  const std::vector<const ir::Stmt*> sa = test::Motions(a), sb = test::Motions(b);
   ASSERT_EQ(sa.size(), sb.size()) << what;
   for (std::size_t s = 0; s < sa.size(); ++s) {
     const std::span<const MachineTarget> x = plan_a.Of(sa[s]), y = plan_b.Of(sb[s]);

@@ -17,6 +17,8 @@
 
 #include <fmt/format.h>
 
+#include "ir/ir_walk.h"
+
 namespace smtcal::test {
 
 inline std::string RandomPlaceProgram(std::uint64_t seed) {
@@ -116,6 +118,17 @@ inline std::string RandomPlaceProgram(std::uint64_t seed) {
   if (taught) text += pick_line("    ") + "    Place T LimZ -1.0\n";
   text += "  EndCycle\nFend\n";
   return text;
+}
+
+// The motion statements of a program (Motion, Pick, Place), in order.
+inline std::vector<const ir::Stmt*> Motions(const ir::Program& program) {
+  std::vector<const ir::Stmt*> motions;
+  ir::ForEachStmt(program.items, [&](const ir::Stmt& stmt) {
+    if (std::holds_alternative<ir::Motion>(stmt.node) || std::holds_alternative<ir::PickPlace>(stmt.node)) {
+      motions.push_back(&stmt);
+    }
+  });
+  return motions;
 }
 
 }  // namespace smtcal::test
