@@ -25,6 +25,8 @@ void Add(ChangeStats& stats, const NodeChange& node, std::size_t index, double t
     stats.max_abs_um = magnitude;
     stats.largest = index;
   }
+  stats.min_um = stats.nodes == 0 ? node.change_um : std::min(stats.min_um, node.change_um);
+  stats.max_um = stats.nodes == 0 ? node.change_um : std::max(stats.max_um, node.change_um);
   ++stats.nodes;
   stats.mean_um += node.change_um;
   stats.rms_um += node.change_um * node.change_um;
@@ -47,6 +49,8 @@ std::vector<double> Within(const std::vector<double>& lines, double lo, double h
 }
 
 }  // namespace
+
+bool ChangeStats::uniform() const { return nodes > 1 && max_um - min_um < kTableDiffUniformUm; }
 
 TableChanges CompareTables(const ErrorTable& old_table, const ErrorTable& new_table, double threshold_um,
                            const std::vector<cell::Region>* regions) {
@@ -121,8 +125,14 @@ TableChanges CompareTables(const ErrorTable& old_table, const ErrorTable& new_ta
 }
 
 std::vector<std::size_t> LargestChanges(const TableChanges& changes, std::size_t count) {
-  std::vector<std::size_t> order(changes.nodes.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < changes.nodes.size(); ++i) {
+    // A change printed as 0.0 µm is not a change that ranks.
+    if (!changes.axes[static_cast<int>(changes.nodes[i].axis)].stats.uniform() &&
+        std::fabs(changes.nodes[i].change_um) >= kTableDiffUniformUm) {
+      order.push_back(i);
+    }
+  }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return std::fabs(changes.nodes[a].change_um) > std::fabs(changes.nodes[b].change_um);
   });

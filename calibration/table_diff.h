@@ -33,6 +33,10 @@ struct ChangeStats {
   double max_abs_um = 0;  // the largest |change|
   double mean_um = 0;     // signed: a shift of the whole table shows here
   double rms_um = 0;
+  double min_um = 0, max_um = 0;  // the smallest and largest change, signed
+  // Every node changed alike: the spread of the changes is below what a
+  // change is printed to (kTableDiffUniformUm), so no node changed "most".
+  bool uniform() const;
   std::size_t largest = 0;  // index into TableChanges::nodes; valid when nodes > 0
   std::size_t beyond = 0;   // nodes whose |change| is above the threshold
 };
@@ -63,8 +67,14 @@ struct TableChanges {
 TableChanges CompareTables(const ErrorTable& old_table, const ErrorTable& new_table, double threshold_um,
                            const std::vector<cell::Region>* regions);
 
+// The spread below which an axis's change is uniform: half the 0.1 µm a
+// change is printed to.
+inline constexpr double kTableDiffUniformUm = 0.05;
+
 // The nodes with the largest |change|, at most `count`, largest first (ties
-// in node order).
+// in node order), of the axes whose change is not uniform (a uniform change
+// has no node that changed most); a node whose |change| is below
+// kTableDiffUniformUm (printed as 0.0 µm) is never among them.
 std::vector<std::size_t> LargestChanges(const TableChanges& changes, std::size_t count);
 
 // The change as a table (B - A in mm) on one grid per axis: A's lines

@@ -4,7 +4,7 @@
 // machine_targets.h and calibration/machine_model.h; this file wires files,
 // cells, options and exit codes: which cell each program is evaluated with
 // (given, or the one a compiled program records), and LinuxCNC outputs read
-// back through frontend/linuxcnc_output.h.
+// back through backend/linuxcnc/linuxcnc_output.h.
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -20,7 +20,7 @@
 #include "calibration/limits.h"
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
-#include "frontend/linuxcnc_output.h"
+#include "backend/linuxcnc/linuxcnc_output.h"
 #include "frontend/parse.h"
 #include "ir/ir_ops.h"
 #include "passes/machine_targets.h"
@@ -39,6 +39,7 @@ struct DiffCommandOptions {
   bool json = false;
   std::string svg_path;
   bool exit_zero = false;
+  std::string machine = "new";  // whose cell describes the machine: new | old
 };
 
 // Parses a program and runs the semantic checks, like `smtcal check`.
@@ -62,7 +63,7 @@ struct Side {
   const cell::Cell* cell = nullptr;
   diff::DiffSideCell described;
   MachineTargets targets;
-  std::vector<std::uint32_t> line_map;  // a LinuxCNC output: program line -> .ngc line
+  std::optional<LinuxCncOutputRead> linuxcnc;  // a LinuxCNC output, as read back
 };
 
 // Loads cells once per path.
@@ -257,10 +258,10 @@ void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
                      "read back, it is a program smtcal does not accept: " + diagnostic.message);
         break;
       }
-      side->line_map = std::move(output.line_map);
       side->compiled = true;
-      side->cell = cells.Keep(std::move(output.cell));
+      side->cell = cells.Keep(output.cell);  // the read keeps its own: CheckLinuxCncCommands names its fixtures
       side->described.how = fmt::format("the runtime's data in {}", output.data_path);
+      side->linuxcnc = std::move(output);
       continue;
     }
     Result<std::uint32_t> file = sources.Load(side->path);
@@ -316,19 +317,21 @@ void RunDiff(const DiffCommandOptions& opt, GlobalOptions& options) {
     for (Side* side : {&old_side, &new_side}) {
       side->targets = side->compiled ? CompiledProgramTargets(side->program, *side->cell, diags)
                                      : SourceProgramTargets(side->program, *side->cell, diags);
+      // Each position is commanded as the runtime is told to.
+      if (side->linuxcnc) CheckLinuxCncCommands(side->program, side->targets, *side->linuxcnc, diags);
     }
     if (diags.has_errors()) {
       options.exit_code = PrintDiagnostics(diags, options);
       return;
     }
     diff::CompareOnMachine(result, {old_side.cell, &old_side.targets, old_side.described},
-                           {new_side.cell, &new_side.targets, new_side.described});
+                           {new_side.cell, &new_side.targets, new_side.described}, opt.machine == "old");
   }
   options.exit_code = PrintDiagnostics(diags, options);
   if (options.exit_code != kExitOk) return;
   // A LinuxCNC output's lines are the .ngc file's.
-  if (!old_side.line_map.empty()) diff::RemapLines(result, /*new_side=*/false, old_side.line_map);
-  if (!new_side.line_map.empty()) diff::RemapLines(result, /*new_side=*/true, new_side.line_map);
+  if (old_side.linuxcnc) diff::RemapLines(result, /*new_side=*/false, old_side.linuxcnc->line_map);
+  if (new_side.linuxcnc) diff::RemapLines(result, /*new_side=*/true, new_side.linuxcnc->line_map);
   if (!opt.svg_path.empty()) {
     if (Status written = WriteFileAtomically(opt.svg_path, diff::PlotDiffSvg(result)); !written) {
       options.exit_code = ReportIoError(written.error());
@@ -365,6 +368,12 @@ void AddDiffCommand(CLI::App& app, GlobalOptions& options) {
   diff->add_option("--new-cell", opt.new_cell_path, "the cell NEW was compiled for (when it is not OLD's)");
   AddNumberOption(*diff, "--threshold", opt.threshold_um, "the gate: a target that moved by more than this many µm fails it",
                   limits::kDiffThresholdUm)
+      ->capture_default_str();
+  diff->add_option("--machine", opt.machine,
+                   "whose cell describes the machine both programs run on, the robot (its tables) and the boards "
+                   "(their marker edges): new (the latest description of the real cell) or old; each program brings "
+                   "its own cell's tables, marker geometry, estimator, scan paths and limits")
+      ->check(CLI::IsMember({"new", "old"}))
       ->capture_default_str();
   diff->add_flag("--json", opt.json, "print the diff as JSON (schema in docs/diff.md) instead of text");
   diff->add_option("--svg", opt.svg_path,

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -77,7 +78,7 @@ std::string PositionText(const MachineMove& move) {
 // "command 12.0 µm toward 180.0° (...) in robot base with Board at its
 // nominal pose, lands 12.0 µm; at most 12.1 µm with Board shifted ...".
 std::string DescribeMachineMove(const MachineMove& move) {
-  if (!move.comparable) return "cannot be compared on the machine: " + move.note;
+  if (!move.comparable) return move.note;
   std::string text = "command " + DescribeMove(move.command);
   if (!move.board.empty()) text += fmt::format(" with {} at its nominal pose", move.board);
   text += fmt::format(", lands {} µm", Um(move.lands.d_um));
@@ -93,8 +94,8 @@ std::string DescribeMachineMove(const MachineMove& move) {
 std::string MachineLines(const ProgramDiff& diff, const Change& change, const std::string& now, const std::string& was) {
   std::string lines;
   for (const MachineMove& move : change.machine) {
-    lines += fmt::format("{}: moved {}{}{} (was {}): {}", now, change.what, Where(change), PositionText(move), was,
-                         DescribeMachineMove(move));
+    lines += fmt::format("{}: {} {}{}{} (was {}): {}", now, move.comparable ? "moved" : "cannot compare", change.what,
+                         Where(change), PositionText(move), was, DescribeMachineMove(move));
     if (move.beyond_threshold) lines += fmt::format(" [more than {} µm]", Um(diff.threshold_um));
     lines += "\n";
   }
@@ -106,7 +107,8 @@ std::string ChangeLine(const ProgramDiff& diff, const Change& change) {
   const std::string now = change.new_side.loc.known() ? Loc(diff.new_file, change.new_side.loc) : "";
   // A motion statement on the machine: its positions, not its text, moved.
   const bool machine = diff.on_machine && change.is_target && !change.function.empty() &&
-                       (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged);
+                       (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged ||
+                        change.kind == ChangeKind::kReordered);
   std::string line;
   switch (change.kind) {
     case ChangeKind::kMoved:
@@ -131,6 +133,11 @@ std::string ChangeLine(const ProgramDiff& diff, const Change& change) {
       line = fmt::format("{}: removed {}{}", was, change.what,
                          change.function.empty() ? "" : " from " + change.function);
       if (!change.note.empty()) line += " (" + change.note + ")";
+      break;
+    case ChangeKind::kReordered:
+      line = fmt::format("{}: reordered {}{} (was {}): the same {}, in another order", now, change.what, Where(change),
+                         was, change.is_target ? "position" : "line");
+      if (machine && !change.machine.empty()) return line + "\n" + MachineLines(diff, change, now, was);
       break;
   }
   if (change.beyond_threshold) line += fmt::format(" [more than {} µm]", Um(diff.threshold_um));
@@ -161,6 +168,9 @@ std::string GateLine(const ProgramDiff& diff) {
   if (s.added > 0) why.push_back(fmt::format("{} added", s.added));
   if (s.removed > 0) why.push_back(fmt::format("{} removed", s.removed));
   if (s.changed > 0) why.push_back(fmt::format("{} changed", s.changed));
+  if (s.reordered > 0) {
+    why.push_back(fmt::format("{} reordered (the same positions in another order: a change of sequence)", s.reordered));
+  }
   if (s.not_comparable > 0 && s.changed == 0) why.push_back(fmt::format("{} not comparable", s.not_comparable));
   return fmt::format("gate: failed: {}\n", fmt::join(why, ", "));
 }
@@ -180,16 +190,21 @@ std::string MachineHeader(const ProgramDiff& diff) {
   text += diff.tables_differ.empty()
               ? std::string("the cells hold the same tables and fixtures\n")
               : fmt::format("the cells differ in: {}\n", fmt::join(diff.tables_differ, ", "));
-  text += "on the machine: each program through its own cell, the robot moving as NEW's cell says";
+  text += fmt::format(
+      "on the machine: one robot and one board, as {0}'s cell describes them (--machine {1}); each program with its "
+      "own cell's tables, marker geometry, estimator, scan paths and limits",
+      diff.machine, diff.machine == "NEW" ? "new" : "old");
   if (diff.poses > 1) {
     text += fmt::format(
-        "; board targets at {} poses within the fixtures' check limits, as far out as the robot's scan accepts",
+        "; board targets at {} poses within the fixtures' check limits, as far out as both programs' scans accept",
         diff.poses);
   }
   if (!diff.refused_poses.empty()) {
     text += fmt::format(" ({} refused by both programs' scans: not compared)", fmt::join(diff.refused_poses, ", "));
   }
-  return text + "\n";
+  text += "\n";
+  for (const std::string& acceptance : diff.acceptance) text += "accepted boards: " + acceptance + "\n";
+  return text;
 }
 
 }  // namespace
@@ -213,8 +228,10 @@ std::string FormatDiffText(const ProgramDiff& diff) {
                         s.targets_moved, s.beyond_threshold, Um(diff.threshold_um));
     if (s.largest_um > 0) text += fmt::format(", largest {} µm ({})", Um(s.largest_um), LargestWhere(diff));
   }
-  text += fmt::format("; {} not comparable; {} added, {} removed, {} changed\n", s.not_comparable, s.added, s.removed,
+  text += fmt::format("; {} not comparable; {} added, {} removed, {} changed", s.not_comparable, s.added, s.removed,
                       s.changed);
+  if (s.reordered > 0) text += fmt::format(", {} reordered", s.reordered);
+  text += "\n";
   return text + GateLine(diff);
 }
 
@@ -294,8 +311,11 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
   if (diff.on_machine) {
     ordered_json differ = ordered_json::array();
     for (const std::string& what : diff.tables_differ) differ.push_back(what);
+    ordered_json acceptance = ordered_json::array();
+    for (const std::string& what : diff.acceptance) acceptance.push_back(what);
     root["cells"] = {{"old", JsonCell(*diff.old_cell)}, {"new", JsonCell(*diff.new_cell)}, {"differ", differ},
-                     {"poses", diff.poses}};
+                     {"machine", diff.machine == "NEW" ? "new" : "old"}, {"poses", diff.poses},
+                     {"acceptance", acceptance}};
   } else {
     root["cells"] = ordered_json();
   }
@@ -328,6 +348,7 @@ std::string FormatDiffJson(const ProgramDiff& diff) {
   summary["added"] = s.added;
   summary["removed"] = s.removed;
   summary["changed"] = s.changed;
+  summary["reordered"] = s.reordered;
   if (s.largest_um > 0) {
     const Change& c = diff.changes[s.largest];
     summary["largest"] = {{"d_um", JsonNumber(s.largest_um)}, {"what", c.what},
@@ -377,6 +398,7 @@ struct Mark {
   std::optional<Pose4> to;         // new position of a moved target (on the machine: at + the worst move)
   double um = 0;                   // the move the gate judged
   bool beyond = false;             // more than the threshold
+  bool not_comparable = false;     // a position that cannot be compared: a red ring
   std::string label;               // "R1", "line 66", "line 66 (1/3)"
 };
 
@@ -567,16 +589,34 @@ double MedianSpacingMm(const std::vector<Panel>& panels) {
 std::string PlotDiffSvg(const ProgramDiff& diff) {
   // Group what can be drawn by frame: robot base first, then fixtures by name.
   std::map<std::string, Panel> by_frame;
+  std::size_t not_comparable = 0;   // red rings
+  std::set<std::string> reasons;    // why they cannot be compared
   for (const Change& change : diff.changes) {
     if (!change.is_target) continue;
     const bool machine = diff.on_machine && !change.function.empty() &&
-                         (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged);
+                         (change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged ||
+                          change.kind == ChangeKind::kReordered);
     // On the machine the picture shows positions: a point's coordinates are text.
     if (diff.on_machine && change.function.empty()) continue;
     if (machine) {  // its positions, where NEW wants them at the nominal pose, and their worst moves
       Panel& panel = by_frame["robot base"];
       for (const MachineMove& move : change.machine) {
-        if (!move.comparable || !move.moved) continue;
+        if (!move.comparable) {  // a red ring where NEW puts it; the header says why
+          if (!move.located) continue;
+          Mark mark;
+          mark.change = &change;
+          mark.at = move.required;
+          mark.not_comparable = true;
+          mark.label = move.count > 1 ? fmt::format("line {} ({}/{}): not comparable", change.new_side.loc.line,
+                                                    move.index + 1, move.count)
+                                      : fmt::format("line {}: not comparable", change.new_side.loc.line);
+          panel.marks.push_back(std::move(mark));
+          ++panel.compared;
+          ++not_comparable;
+          reasons.insert(move.note);
+          continue;
+        }
+        if (!move.moved) continue;
         Mark mark;
         mark.change = &change;
         mark.at = move.required;
@@ -679,6 +719,10 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
                                      kArrowSpacingFill, spacing_mm, kArrowFill)
                        : fmt::format(", within {:g} of the panel", kArrowFill)));
   }
+  if (not_comparable > 0) {
+    header.push_back(fmt::format("red ring: a position that cannot be compared on the machine ({}), where NEW puts it: {}",
+                                 not_comparable, fmt::join(reasons, "; ")));
+  }
   header.push_back(fmt::format("green +: added; red ×: removed. {}",
                                diff.base_frame_known ? "Fixture targets at the fixtures' nominal poses (--cell)."
                                                      : "Fixture targets in their fixture's frame (no --cell)."));
@@ -738,6 +782,14 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
   }
   std::stable_sort(ranked.begin(), ranked.end(), [](const Mark* a, const Mark* b) { return a->um > b->um; });
   if (ranked.size() > kLabelled) ranked.resize(kLabelled);
+  // The positions that cannot be compared come first: the gate fails on them.
+  std::vector<const Mark*> rings;
+  for (const Panel& p : panels) {
+    for (const Mark& m : p.marks) {
+      if (m.not_comparable && rings.size() < kLabelled) rings.push_back(&m);
+    }
+  }
+  ranked.insert(ranked.begin(), rings.begin(), rings.end());
 
   std::string svg = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
@@ -808,6 +860,10 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
       } else if (m.change->kind == ChangeKind::kAdded) {
         svg += fmt::format("    <path d=\"M{} {}h10M{} {}v10\" stroke=\"#1a9641\" stroke-width=\"2\"/>\n",
                            Num(px - 5), Num(py), Num(px), Num(py - 5));
+      } else if (m.not_comparable) {
+        svg += fmt::format("    <circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"none\" stroke=\"#d7191c\" "
+                           "stroke-width=\"2\"/>\n",
+                           Num(px), Num(py));
       } else if (m.change->kind == ChangeKind::kRemoved) {
         svg += fmt::format("    <path d=\"M{} {}l8 8M{} {}l-8 8\" stroke=\"#d7191c\" stroke-width=\"2\"/>\n",
                            Num(px - 4), Num(py - 4), Num(px + 4), Num(py - 4));
@@ -829,9 +885,9 @@ std::string PlotDiffSvg(const ProgramDiff& diff) {
     std::vector<Box> labels;
     for (const Mark* c : ranked) {
       if (c < p.marks.data() || c >= p.marks.data() + p.marks.size()) continue;  // another panel's
-      const double tx = p.Px(c->at[0] + enlarge * ((*c->to)[0] - c->at[0]));
-      const double ty = p.Py(c->at[1] + enlarge * ((*c->to)[1] - c->at[1]));
-      const std::string text = fmt::format("{}: {} µm", c->label, Um(c->um));
+      const double tx = c->to ? p.Px(c->at[0] + enlarge * ((*c->to)[0] - c->at[0])) : p.Px(c->at[0]);
+      const double ty = c->to ? p.Py(c->at[1] + enlarge * ((*c->to)[1] - c->at[1])) : p.Py(c->at[1]);
+      const std::string text = c->not_comparable ? c->label : fmt::format("{}: {} µm", c->label, Um(c->um));
       std::vector<std::pair<double, double>> others;
       for (const auto& [owner, at] : points) {
         if (owner != c) others.push_back(at);

@@ -1,7 +1,8 @@
 // The diff on the machine (CompareOnMachine in program_diff.h, docs/diff.md
 // "On the machine"): every position of every matched motion statement
-// through calibration/machine_model.h, OLD with OLD's cell and NEW with
-// NEW's, on a robot that moves as NEW's cell says.
+// through calibration/machine_model.h, OLD with OLD's cell's constants and
+// NEW with NEW's, on one machine: the robot and the boards of NEW's cell (or
+// OLD's), at the poses both programs' scans accept.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -117,13 +118,16 @@ std::vector<std::string> RegionsThatDiffer(const cell::Cell& old_cell, const cel
 
 class MachineComparer {
  public:
-  MachineComparer(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side)
+  MachineComparer(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side, bool old_is_machine)
       : diff_(diff),
         old_(old_side),
         new_(new_side),
-        old_model_(*old_side.cell, *new_side.cell),
-        new_model_(*new_side.cell, *new_side.cell),
-        same_cells_(SameMachineData(*old_side.cell, *new_side.cell)) {}
+        world_(old_is_machine ? *old_side.cell : *new_side.cell),
+        old_model_(*old_side.cell, world_),
+        new_model_(*new_side.cell, world_),
+        same_cells_(SameMachineData(*old_side.cell, *new_side.cell)) {
+    diff_.machine = old_is_machine ? "OLD" : "NEW";
+  }
 
   void Run() {
     diff_.on_machine = true;
@@ -209,6 +213,12 @@ class MachineComparer {
 
   // Fills `move`; true when it is worth reporting (moved or not comparable).
   bool ComparePosition(const MachineTarget& a, const MachineTarget& b, MachineMove& move) {
+    // Where the picture draws it when it cannot be compared: where NEW's
+    // program puts it with the board at its nominal pose.
+    if (b.known || a.known) {
+      move.required = b.known ? NominalPlace(b, *new_.cell) : NominalPlace(a, *old_.cell);
+      move.located = true;
+    }
     if (!a.known || !b.known) {
       // The same unknown position under the same tables moves nothing.
       if (!a.known && !b.known && same_cells_ && a.kind == b.kind && a.fixture == b.fixture) return false;
@@ -231,6 +241,7 @@ class MachineComparer {
         return true;
       }
       move.board = b_board ? b_name : a_name;
+      SharePoses(move.board);
       poses = b_board ? new_model_.Poses(static_cast<std::size_t>(b.fixture)).size()
                       : old_model_.Poses(static_cast<std::size_t>(a.fixture)).size();
       diff_.poses = std::max(diff_.poses, poses);
@@ -258,8 +269,8 @@ class MachineComparer {
         if (old_refused || new_refused) {
           move.comparable = false;
           move.note = fmt::format("with {} {} {}'s scan refuses the board ({}) and {}'s does not", move.board,
-                                  DescribeBoardPose((*pose_list)[p]), old_refused ? "OLD" : "NEW",
-                                  old_refused ? old_why : new_why, old_refused ? "NEW" : "OLD");
+                                  AtPose((*pose_list)[p]), old_refused ? "OLD" : "NEW", old_refused ? old_why : new_why,
+                                  old_refused ? "NEW" : "OLD");
           return true;
         }
       }
@@ -270,9 +281,8 @@ class MachineComparer {
       if (!old_at.ok && !new_at.ok) continue;
       if (!old_at.ok || !new_at.ok) {
         move.comparable = false;
-        const std::string where = pose_list != nullptr ? fmt::format(" with {} {}", move.board,
-                                                                     DescribeBoardPose((*pose_list)[p]))
-                                                       : "";
+        const std::string where =
+            pose_list != nullptr ? fmt::format(" with {} {}", move.board, AtPose((*pose_list)[p])) : "";
         move.note = !old_at.ok ? fmt::format("OLD commands nothing{}: {}", where, old_at.why)
                                : fmt::format("NEW commands nothing{}: {}", where, new_at.why);
         return true;
@@ -301,6 +311,60 @@ class MachineComparer {
     return move.moved;
   }
 
+  // The poses of `board`, the same for both programs (CommonPoses), set once;
+  // and where their scans accept different boards, what they accept.
+  void SharePoses(const std::string& board) {
+    if (!shared_.insert(sema::Lowercase(board)).second) return;
+    std::vector<std::pair<MachineModel*, std::size_t>> models;
+    std::vector<std::pair<const MachineModel*, std::size_t>> scanners;
+    for (MachineModel* model : {&old_model_, &new_model_}) {
+      if (const cell::Fixture* fixture = model->side().FindFixture(board)) {
+        models.emplace_back(model, static_cast<std::size_t>(fixture - model->side().fixtures.data()));
+        scanners.emplace_back(models.back());
+      }
+    }
+    const std::vector<BoardPose> poses = CommonPoses(scanners);
+    for (const auto& [model, fixture] : models) model->SetPoses(fixture, poses);
+    if (scanners.size() == 2 && !same_cells_) DescribeAcceptance(board, scanners);
+  }
+
+  // "Board: OLD's scan accepts ... NEW's ..." where the two scans accept the
+  // board out to other poses (beyond the bisection's 1/1024).
+  void DescribeAcceptance(const std::string& board,
+                          const std::vector<std::pair<const MachineModel*, std::size_t>>& scanners) {
+    double shift = 0, rotation = 0;
+    for (const auto& [model, fixture] : scanners) {
+      shift = std::max(shift, model->side().fixtures[fixture].max_shift_mm);
+      rotation = std::max(rotation, model->side().fixtures[fixture].max_rotation_deg);
+    }
+    const std::vector<BoardPose> limits = CheckLimitPoses(shift, rotation);
+    const std::vector<double> a = AcceptedFractions(*scanners[0].first, scanners[0].second, limits);
+    const std::vector<double> b = AcceptedFractions(*scanners[1].first, scanners[1].second, limits);
+    std::size_t differ = 0, widest = 0;
+    double widest_gap = 0;
+    for (std::size_t p = 0; p < limits.size(); ++p) {
+      const double gap = std::fabs(a[p] - b[p]);
+      if (gap <= 1.5 / 1024) continue;
+      ++differ;
+      if (gap > widest_gap) {
+        widest_gap = gap;
+        widest = p;
+      }
+    }
+    if (differ == 0) return;
+    diff_.acceptance.push_back(fmt::format(
+        "{}: the scans accept other boards in {} of {} directions (the most toward {}: OLD's out to {}, NEW's to "
+        "{}); only poses both accept are compared",
+        board, differ, limits.size(), DescribeBoardPose(limits[widest]),
+        a[widest] == 0 ? "none" : DescribeBoardPose(ScaledPose(limits[widest], a[widest])),
+        b[widest] == 0 ? "none" : DescribeBoardPose(ScaledPose(limits[widest], b[widest]))));
+  }
+
+  // "at its nominal pose", "shifted 1.980 mm toward 0°": after "with Board".
+  static std::string AtPose(const BoardPose& pose) {
+    return pose.nominal() ? std::string("at its nominal pose") : DescribeBoardPose(pose);
+  }
+
   // Whether `model`'s controller refuses the scan of `board` at pose `p`
   // (false when its cell has no such fixture: its program scans none).
   static bool Refuses(const MachineModel& model, const std::string& board, std::size_t p, std::string& why) {
@@ -310,24 +374,31 @@ class MachineComparer {
     return !model.ScanFix(index, p, &why).has_value();
   }
 
-  // An unmoved position in the picture: where NEW wants it at the nominal pose.
-  void Unchanged(const MachineTarget& target) {
-    if (!target.known) return;
+  // A position in the base frame with its board at the nominal pose `cell` gives it.
+  static Pose4 NominalPlace(const MachineTarget& target, const cell::Cell& cell) {
     Pose4 at = target.position;
     if (target.kind == MachineTarget::Kind::kFixture) {
-      const cell::Fixture& fixture = new_.cell->fixtures[static_cast<std::size_t>(target.fixture)];
+      const cell::Fixture& fixture = cell.fixtures[static_cast<std::size_t>(target.fixture)];
       const Eigen::Vector2d base = ToBase(NominalFix(fixture), {at[0], at[1]});
       at = {base.x(), base.y(), at[2], at[3] + fixture.angle_deg};
     }
-    diff_.unchanged_plot.push_back(at);
+    return at;
+  }
+
+  // An unmoved position in the picture: where NEW wants it at the nominal pose.
+  void Unchanged(const MachineTarget& target) {
+    if (!target.known) return;
+    diff_.unchanged_plot.push_back(NominalPlace(target, *new_.cell));
     diff_.unchanged_plot_frame.push_back("robot base");
     diff_.unchanged_plot_statement.push_back(true);
   }
 
   std::map<std::string, std::set<std::size_t>> refused_;  // per board: the poses both programs' scans refuse
+  std::set<std::string> shared_;                          // boards whose poses are set (lowercase)
   ProgramDiff& diff_;
   const MachineSide& old_;
   const MachineSide& new_;
+  MachineWorld world_;
   MachineModel old_model_;
   MachineModel new_model_;
   bool same_cells_;
@@ -335,11 +406,12 @@ class MachineComparer {
 
 }  // namespace
 
-void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side) {
+void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side,
+                      bool old_is_machine) {
   SMTCAL_CHECK(old_side.cell != nullptr && new_side.cell != nullptr && old_side.targets != nullptr &&
                    new_side.targets != nullptr,
                "both sides of the machine comparison have a cell and targets");
-  MachineComparer(diff, old_side, new_side).Run();
+  MachineComparer(diff, old_side, new_side, old_is_machine).Run();
 }
 
 }  // namespace smtcal::diff

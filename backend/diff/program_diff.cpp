@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <variant>
 
 #include <fmt/format.h>
@@ -31,6 +32,7 @@ std::string_view ChangeKindName(ChangeKind kind) {
     case ChangeKind::kChanged: return "changed";
     case ChangeKind::kAdded: return "added";
     case ChangeKind::kRemoved: return "removed";
+    case ChangeKind::kReordered: return "reordered";
   }
   return "changed";
 }
@@ -827,15 +829,82 @@ class Differ {
       const Pose4& q = b[j].placement->written;
       return 0.9 / (1 + std::hypot(p[0] - q[0], p[1] - q[1]) / (1.25 * kAlikeMm));
     };
-    for (const Aligned& pair : Align(sig_a, sig_b, similarity)) {
+    const std::vector<Aligned> aligned = Align(sig_a, sig_b, similarity);
+    // A statement only OLD has at one place and only NEW at another, the same
+    // line both times, moved in the sequence: reordered (each pairs the first
+    // of its kind not yet paired, in order).
+    std::map<std::size_t, std::size_t> moved_from;  // NEW's index -> OLD's
+    std::set<std::size_t> moved_away;               // OLD's indices paired
+    {
+      std::multimap<std::string, std::size_t> removed;
+      for (const Aligned& pair : aligned) {
+        if (pair.new_index == Aligned::npos && a[pair.old_index].reported && !IsBlockLine(a[pair.old_index])) {
+          removed.emplace(a[pair.old_index].text, pair.old_index);
+        }
+      }
+      for (const Aligned& pair : aligned) {
+        if (pair.old_index != Aligned::npos || !b[pair.new_index].reported || IsBlockLine(b[pair.new_index])) continue;
+        auto found = removed.find(b[pair.new_index].text);
+        if (found == removed.end()) continue;
+        moved_from[pair.new_index] = found->second;
+        moved_away.insert(found->second);
+        removed.erase(found);
+      }
+    }
+    for (const Aligned& pair : aligned) {
       if (pair.old_index == Aligned::npos) {
-        if (b[pair.new_index].reported) Added(b[pair.new_index], name);
+        auto from = moved_from.find(pair.new_index);
+        if (from != moved_from.end()) {
+          Reordered(a[from->second], b[pair.new_index], name);
+        } else if (b[pair.new_index].reported) {
+          Added(b[pair.new_index], name);
+        }
       } else if (pair.new_index == Aligned::npos) {
-        if (a[pair.old_index].reported) Removed(a[pair.old_index], name);
+        if (a[pair.old_index].reported && !moved_away.contains(pair.old_index)) Removed(a[pair.old_index], name);
       } else if (a[pair.old_index].reported) {
         ComparePair(a[pair.old_index], b[pair.new_index], name);
       }
     }
+  }
+
+  // A line that opens or closes a block (For, If, Cycle ...): moved in the
+  // sequence, it changes what the statements around it do.
+  static bool IsBlockLine(const Item& item) {
+    return item.branch > 0 || std::holds_alternative<ir::For>(item.stmt->node) ||
+           std::holds_alternative<ir::If>(item.stmt->node) || std::holds_alternative<ir::Cycle>(item.stmt->node);
+  }
+
+  // The same line at another place of the sequence: one change; a motion is
+  // compared on the machine like any matched one (its positions may move
+  // there when the cells differ).
+  void Reordered(const Item& a, const Item& b, const std::string& function) {
+    Change change = Make(ChangeKind::kReordered, &a, &b, function);
+    change.note = "the same, in another order";
+    if (a.branch <= 0 && ir::MotionTarget(*a.stmt) != nullptr && ir::MotionTarget(*b.stmt) != nullptr) {
+      RememberMatched(a, b, change, function);
+      diff_.matched.back().change = diff_.changes.size();
+      ++diff_.statements_compared;
+    }
+    if (a.placement && b.placement && a.placement->known && b.placement->known && a.placement->symbolic.empty()) {
+      change.plot_frame = comparer_.PlotFrame(*b.placement);
+      change.old_plot = comparer_.PlotPose(*a.placement);
+      change.new_plot = comparer_.PlotPose(*b.placement);
+    }
+    diff_.changes.push_back(std::move(change));
+  }
+
+  // A matched motion statement, remembered for CompareOnMachine; its change
+  // (if any) is the next one pushed.
+  void RememberMatched(const Item& a, const Item& b, const Change& change, const std::string& function) {
+    MatchedStatement matched;
+    matched.old_stmt = a.stmt;
+    matched.new_stmt = b.stmt;
+    matched.old_loc = change.old_side.loc;
+    matched.new_loc = change.new_side.loc;
+    matched.text = b.text;
+    matched.function = function;
+    matched.insert_at = diff_.changes.size();
+    diff_.matched.push_back(std::move(matched));
   }
 
   // ---------------------------------------------------------------- changes
@@ -880,17 +949,7 @@ class Differ {
     bool moved = false;
     // A motion statement may move on the machine whatever its text says: remembered for CompareOnMachine.
     const bool motion = a.branch <= 0 && ir::MotionTarget(*a.stmt) != nullptr && ir::MotionTarget(*b.stmt) != nullptr;
-    if (motion) {
-      MatchedStatement matched;
-      matched.old_stmt = a.stmt;
-      matched.new_stmt = b.stmt;
-      matched.old_loc = change.old_side.loc;
-      matched.new_loc = change.new_side.loc;
-      matched.text = b.text;
-      matched.function = function;
-      matched.insert_at = diff_.changes.size();
-      diff_.matched.push_back(std::move(matched));
-    }
+    if (motion) RememberMatched(a, b, change, function);
     // Pushes the change, remembering it for the matched statement.
     auto push = [&](Change&& made) {
       if (motion) diff_.matched.back().change = diff_.changes.size();
@@ -985,10 +1044,12 @@ void Summarize(ProgramDiff& diff) {
       case ChangeKind::kAdded: ++s.added; break;
       case ChangeKind::kRemoved: ++s.removed; break;
       case ChangeKind::kChanged: ++s.changed; break;
+      case ChangeKind::kReordered: ++s.reordered; break;
       case ChangeKind::kMoved: break;
     }
     if (!change.is_target) continue;
-    const bool both = change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged;
+    const bool both = change.kind == ChangeKind::kMoved || change.kind == ChangeKind::kChanged ||
+                      change.kind == ChangeKind::kReordered;
     if (diff.on_machine && both && !change.function.empty()) {  // a motion statement: its positions
       change.beyond_threshold = false;
       for (std::size_t p = 0; p < change.machine.size(); ++p) {

@@ -51,8 +51,11 @@ enum class ChangeKind {
   kChanged,  // something other than coordinates changed (possibly also moved)
   kAdded,    // only in NEW
   kRemoved,  // only in OLD
+  // The same line (the same position) in both, at another place in its
+  // function's sequence: a change of sequence, not a move.
+  kReordered,
 };
-std::string_view ChangeKindName(ChangeKind kind);  // moved | changed | added | removed
+std::string_view ChangeKindName(ChangeKind kind);  // moved | changed | added | removed | reordered
 
 // One position a matched motion statement commands, compared on the machine
 // (docs/diff.md, "On the machine"): each program through its own cell, on a
@@ -63,6 +66,7 @@ struct MachineMove {
   std::string board;      // the fixture whose poses it was evaluated at ("" for a base target)
   std::string region;     // the region that corrects it at the nominal pose, in NEW ("" none)
   Pose4 required{};       // where NEW wants the part at the nominal pose (base frame)
+  bool located = false;   // `required` holds it (not for a position known only at run time)
   bool comparable = true;  // false: note says why (the scan refuses a pose, a point the tables refuse, ...)
   std::string note;
   Displacement command;   // the command's move at the nominal pose, in the robot base frame
@@ -115,15 +119,17 @@ struct Summary {
   std::size_t beyond_threshold = 0;  // moved by more than the threshold
   std::size_t not_comparable = 0;    // matched targets whose positions cannot be compared
   std::size_t added = 0, removed = 0, changed = 0;  // statements and declarations
+  std::size_t reordered = 0;                        // statements the same, in another order
   std::size_t largest = 0;           // index into ProgramDiff::changes; valid when largest_um > 0
   double largest_um = 0;
   std::size_t largest_position = 0;  // on the machine: the index into changes[largest].machine
   std::size_t points_moved_in_text = 0;  // on the machine: point declarations whose coordinates moved (not gated)
-  // The deployment gate (docs/diff.md): passes when nothing was added or
-  // removed, nothing changed other than coordinates, no move could not be
-  // compared, and no target moved by more than the threshold.
+  // The deployment gate (docs/diff.md): passes when nothing was added,
+  // removed or reordered, nothing changed other than coordinates, no move
+  // could not be compared, and no target moved by more than the threshold.
   bool gate_passes() const {
-    return beyond_threshold == 0 && added == 0 && removed == 0 && changed == 0 && not_comparable == 0;
+    return beyond_threshold == 0 && added == 0 && removed == 0 && changed == 0 && reordered == 0 &&
+           not_comparable == 0;
   }
 };
 
@@ -158,8 +164,13 @@ struct ProgramDiff {
   bool on_machine = false;
   std::optional<DiffSideCell> old_cell, new_cell;
   std::vector<std::string> tables_differ;  // "region layer1" for each region whose tables differ
+  // Whose cell describes the machine (the robot and the boards): "NEW" or "OLD".
+  std::string machine = "NEW";
   std::size_t poses = 0;                    // board poses evaluated per fixture
   std::vector<std::string> refused_poses;   // "6 of Board's poses": both programs' scans refuse them
+  // Per board whose programs' scans accept different poses: how (the poses
+  // evaluated are the ones both accept; not gated).
+  std::vector<std::string> acceptance;
   std::vector<MatchedStatement> matched;    // motion statements in both, in NEW's order
   // Targets compared: point declarations; motion statements as text; their
   // positions on the machine (Summary::targets_compared takes the first and
@@ -199,11 +210,14 @@ struct MachineSide {
 };
 // The comparison on the machine (docs/diff.md, "On the machine"): every
 // position of every matched motion statement, each program through its own
-// cell, the robot as NEW's cell describes it, at the nominal pose and the
-// poses of calibration/machine_model.h. Adds the moves to `diff` (a change
-// for a statement whose text did not change but whose positions moved) and
-// summarizes it again. `diff.matched`'s statements must still be alive.
-void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side);
+// cell's constants on ONE machine (calibration/machine_model.h: the robot
+// and the boards of NEW's cell, or OLD's with `old_is_machine`), at the
+// nominal pose and the poses both programs' scans accept out to the check
+// limits. Adds the moves to `diff` (a change for a statement whose text did
+// not change but whose positions moved) and summarizes it again.
+// `diff.matched`'s statements must still be alive.
+void CompareOnMachine(ProgramDiff& diff, const MachineSide& old_side, const MachineSide& new_side,
+                      bool old_is_machine = false);
 
 // ------------------------------------------------------------------ matching
 // Exposed for the unit tests.

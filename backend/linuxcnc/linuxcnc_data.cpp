@@ -278,14 +278,20 @@ std::uint32_t Fnv1a(std::uint32_t hash, std::string_view text) {
 
 }  // namespace
 
-long LinuxCncRuntimeId(const cell::Cell& cell) {
-  std::uint32_t hash = Fnv1a(2166136261u, SMTCAL_VERSION);
+long LinuxCncRuntimeIdOf(std::string_view version, std::string_view data_without_id, std::string_view scan_abort,
+                         std::string_view record, std::string_view record_open) {
+  std::uint32_t hash = Fnv1a(2166136261u, version);
   for (const EmbeddedFile& file : LinuxCncRuntimeFiles()) hash = Fnv1a(Fnv1a(hash, file.name), file.text);
-  hash = Fnv1a(hash, DataText(cell, std::nullopt));
-  hash = Fnv1a(hash, EmitLinuxCncScanAbort(cell));
-  hash = Fnv1a(hash, EmitLinuxCncRecord(cell));
-  hash = Fnv1a(hash, EmitLinuxCncRecordOpen(cell));
+  hash = Fnv1a(hash, data_without_id);
+  hash = Fnv1a(hash, scan_abort);
+  hash = Fnv1a(hash, record);
+  hash = Fnv1a(hash, record_open);
   return static_cast<long>(hash & 0x7fffffffu);
+}
+
+long LinuxCncRuntimeId(const cell::Cell& cell) {
+  return LinuxCncRuntimeIdOf(SMTCAL_VERSION, DataText(cell, std::nullopt), EmitLinuxCncScanAbort(cell),
+                             EmitLinuxCncRecord(cell), EmitLinuxCncRecordOpen(cell));
 }
 
 std::string EmitLinuxCncData(const cell::Cell& cell) { return DataText(cell, LinuxCncRuntimeId(cell)); }

@@ -11,9 +11,10 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "calibration/cell.h"
-#include "frontend/linuxcnc_layout.h"
+#include "backend/linuxcnc/linuxcnc_layout.h"
 
 namespace smtcal {
 
@@ -30,6 +31,13 @@ std::string EmitLinuxCncData(const cell::Cell& cell);
 // rs274 holds exactly). smtcal_data.ngc sets #<_smtcal_runtime_id> to it;
 // the main program refuses to run with another.
 long LinuxCncRuntimeId(const cell::Cell& cell);
+// The same from the texts: the smtcal version that wrote them, this smtcal's
+// runtime files, smtcal_data.ngc without its runtime-id line, and the files
+// written for the cell (smtcal_scan_abort.ngc, smtcal_record.ngc,
+// smtcal_record_open.ngc): what the reader of an output recomputes from the
+// files it finds (linuxcnc_output.h).
+long LinuxCncRuntimeIdOf(std::string_view version, std::string_view data_without_id, std::string_view scan_abort,
+                         std::string_view record, std::string_view record_open);
 
 // A number as rs274 reads it back exactly: a plain decimal (no exponent) with
 // the fewest decimals that round-trip, correctly rounded; "0" for zero.

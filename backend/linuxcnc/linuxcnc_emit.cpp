@@ -59,10 +59,9 @@ constexpr std::size_t kMaxQuotedChars = 60;
 // A `Wait Sw(n) = On` waits in slices of this many seconds (M66 needs a
 // timeout) until the input has the state: the language's Wait has none.
 constexpr double kWaitSliceS = 3600;
-// o<pick_place>'s first argument besides a fixture's index: a base position
-// the runtime corrects through the error tables, or a position as given.
-constexpr int kPickPlaceBase = -1;
-constexpr int kPickPlaceAsWritten = -2;
+// o<pick_place>'s first argument besides a fixture's index (linuxcnc_layout.h).
+constexpr int kPickPlaceBase = linuxcnc_layout::kCommandBase;
+constexpr int kPickPlaceAsWritten = linuxcnc_layout::kCommandAsWritten;
 
 // Comment text rs274 accepts: no parentheses (they would end the comment),
 // no commas right after a word rs274 treats as a command (msg, debug, abort,
@@ -931,59 +930,7 @@ class Emitter {
       used = used || std::holds_alternative<ir::PickPlace>(stmt.node);
     });
     if (!used) return;
-    const std::string timeout = Num(linuxcnc_->vacuum_timeout_s);
-    const int sensor = linuxcnc_->vacuum_sensor_input;
-    const std::string where = SanitizeMessage(Quoted(source_name_));
-    const char axis = linuxcnc_->rotation_axis;
-    auto block = [&](std::string_view text) { out_.Append(fmt::format("{}{}\n", std::string(static_cast<std::size_t>(indent_) * 2, ' '), text)); };
-    Comment(fmt::format("Pick and Place: o<pick_place> call [fixture] [x] [y] [z] [u] [LimZ] [vacuum] [1 Pick or 0 Place] [source line]"));
-    Comment(fmt::format("fixture: the cell's index of the fixture - {}: a base position corrected through the tables - {}: as given",
-                        kPickPlaceBase, kPickPlaceAsWritten));
-    block("o<pick_place> sub");
-    ++indent_;
-    block(fmt::format("o<pick_place_correct> if [#1 GT {}]", kPickPlaceAsWritten));
-    ++indent_;
-    block("o<smtcal_correct> call [#1] [#2] [#3]");
-    block("#2 = #<_smtcal_x>");
-    block("#3 = #<_smtcal_y>");
-    block("#5 = [#5 + #<_smtcal_angle>]");
-    --indent_;
-    block("o<pick_place_correct> endif");
-    block("G0 Z#6");
-    if (const auto& approach = cell_.robot.final_approach_mm) {
-      // The final approach: the last x-y move is robot.final_approach_mm, as
-      // at every node the tables were measured at (backlash taken up alike).
-      block(fmt::format("G0 X[#2 - {}] Y[#3 - {}] {}#5", Num(approach->x()), Num(approach->y()), axis));
-      block("G0 X#2 Y#3");
-    } else {
-      block(fmt::format("G0 X#2 Y#3 {}#5", axis));
-    }
-    block("G0 Z#4");
-    block("o<pick_place_vacuum> if [#8 EQ 1]");
-    ++indent_;
-    block("M64 P#7");
-    block(fmt::format("M66 P{} L3 Q{}", sensor, timeout));
-    --indent_;
-    block("o<pick_place_vacuum> else");
-    ++indent_;
-    block("M65 P#7");
-    block(fmt::format("M66 P{} L4 Q{}", sensor, timeout));
-    --indent_;
-    block("o<pick_place_vacuum> endif");
-    block("o<pick_place_agreed> if [#5399 LT 0]");
-    ++indent_;
-    block("o<pick_place_held> if [#8 EQ 1]");
-    ++indent_;
-    block(fmt::format("(abort,smtcal: Pick at {}:%d#9: vacuum sensor input {} did not report the part held within {} s)",
-                      where, sensor, timeout));
-    --indent_;
-    block("o<pick_place_held> endif");
-    block(fmt::format("(abort,smtcal: Place at {}:%d#9: vacuum sensor input {} did not report the part released within {} s)",
-                      where, sensor, timeout));
-    --indent_;
-    block("o<pick_place_agreed> endif");
-    --indent_;
-    block("o<pick_place> endsub");
+    out_.Append(LinuxCncPickPlaceSubroutine(cell_, source_name_));
   }
 
   // The program's `Vacuum n`, as written (made once).
@@ -1080,6 +1027,82 @@ Status WriteText(const fs::path& path, const std::string& text) {
   return Ok{};
 }
 
+}  // namespace
+
+// The o<pick_place> subroutine (linuxcnc_emit.h): written by the emitter into
+// every main program with a Pick or Place, and compared by the reader of an
+// output (linuxcnc_output.h).
+std::string LinuxCncPickPlaceSubroutine(const cell::Cell& cell, std::string_view source_name) {
+  SMTCAL_CHECK(cell.linuxcnc.has_value(), "the LinuxCNC target has the cell's [linuxcnc] table");
+  const std::string timeout = Num(cell.linuxcnc->vacuum_timeout_s);
+  const int sensor = cell.linuxcnc->vacuum_sensor_input;
+  const std::string where = SanitizeMessage(Quoted(source_name));
+  const char axis = cell.linuxcnc->rotation_axis;
+  std::string text;
+  int indent = 0;
+  auto block = [&](std::string_view line) {
+    text += std::string(static_cast<std::size_t>(indent) * 2, ' ');
+    text += line;
+    text += '\n';
+  };
+  // A comment line cut to fit, as Emitter::Comment cuts it.
+  auto comment = [&](std::string_view line) {
+    std::string body = Sanitize(line);
+    if (body.size() > kMaxLineChars - 2) body = body.substr(0, kMaxLineChars - 5) + "...";
+    text += '(' + body + ")\n";
+  };
+  comment(fmt::format("Pick and Place: o<pick_place> call [fixture] [x] [y] [z] [u] [LimZ] [vacuum] [1 Pick or 0 Place] [source line]"));
+  comment(fmt::format("fixture: the cell's index of the fixture - {}: a base position corrected through the tables - {}: as given",
+                      kPickPlaceBase, kPickPlaceAsWritten));
+  block("o<pick_place> sub");
+  ++indent;
+  block(fmt::format("o<pick_place_correct> if [#1 GT {}]", kPickPlaceAsWritten));
+  ++indent;
+  block("o<smtcal_correct> call [#1] [#2] [#3]");
+  block("#2 = #<_smtcal_x>");
+  block("#3 = #<_smtcal_y>");
+  block("#5 = [#5 + #<_smtcal_angle>]");
+  --indent;
+  block("o<pick_place_correct> endif");
+  block("G0 Z#6");
+  if (const auto& approach = cell.robot.final_approach_mm) {
+    // The final approach: the last x-y move is robot.final_approach_mm, as
+    // at every node the tables were measured at (backlash taken up alike).
+    block(fmt::format("G0 X[#2 - {}] Y[#3 - {}] {}#5", Num(approach->x()), Num(approach->y()), axis));
+    block("G0 X#2 Y#3");
+  } else {
+    block(fmt::format("G0 X#2 Y#3 {}#5", axis));
+  }
+  block("G0 Z#4");
+  block("o<pick_place_vacuum> if [#8 EQ 1]");
+  ++indent;
+  block("M64 P#7");
+  block(fmt::format("M66 P{} L3 Q{}", sensor, timeout));
+  --indent;
+  block("o<pick_place_vacuum> else");
+  ++indent;
+  block("M65 P#7");
+  block(fmt::format("M66 P{} L4 Q{}", sensor, timeout));
+  --indent;
+  block("o<pick_place_vacuum> endif");
+  block("o<pick_place_agreed> if [#5399 LT 0]");
+  ++indent;
+  block("o<pick_place_held> if [#8 EQ 1]");
+  ++indent;
+  block(fmt::format("(abort,smtcal: Pick at {}:%d#9: vacuum sensor input {} did not report the part held within {} s)",
+                    where, sensor, timeout));
+  --indent;
+  block("o<pick_place_held> endif");
+  block(fmt::format("(abort,smtcal: Place at {}:%d#9: vacuum sensor input {} did not report the part released within {} s)",
+                    where, sensor, timeout));
+  --indent;
+  block("o<pick_place_agreed> endif");
+  --indent;
+  block("o<pick_place> endsub");
+  return text;
+}
+
+namespace {
 }  // namespace
 
 std::string LinuxCncMainName(const std::string& program_path) {

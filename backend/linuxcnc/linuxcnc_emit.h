@@ -47,6 +47,12 @@ struct LinuxCncOutput {
 std::optional<LinuxCncOutput> EmitLinuxCnc(const ir::Program& program, const CompileState& state,
                                            const std::string& program_path, TextOutput& main, Diagnostics& diags);
 
+// The o<pick_place> subroutine every main program with a Pick or Place holds
+// (the cell's [linuxcnc] wiring, its final approach; `source_name` the
+// program file named in its abort messages): written by the emitter, and
+// compared by the reader of an output (linuxcnc_output.h).
+std::string LinuxCncPickPlaceSubroutine(const cell::Cell& cell, std::string_view source_name);
+
 // The name of the main program file for a source path: "layers.place" ->
 // "layers.ngc" ("-" -> "program.ngc").
 std::string LinuxCncMainName(const std::string& program_path);

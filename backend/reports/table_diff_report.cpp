@@ -1,6 +1,7 @@
 // Outputs of `smtcal table diff` (backend/reports/table_diff_report.h).
 #include "backend/reports/table_diff_report.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -60,16 +61,38 @@ std::string FormatTableDiffText(const TableChanges& changes, const TableDiffName
       how += fmt::format(" ({} of the old grid's nodes and {} of the new's lie outside it: not compared)",
                          c.old_nodes_outside, c.new_nodes_outside);
     }
-    text += fmt::format("Δ{}: {}: {}\n", AxisName(axis), how,
-                        Rounded(c.stats.max_abs_um, 0.1) == 0 ? std::string("no change (all below 0.1 µm)")
-                                                              : Stats(c.stats, changes.threshold_um));
+    std::string what;
+    if (Rounded(c.stats.max_abs_um, 0.1) == 0) {
+      what = "no change (all below 0.1 µm)";
+    } else if (c.stats.uniform()) {  // no node changed more than another
+      what = fmt::format("a uniform change: every node {} µm", SignedUm(c.stats.mean_um));
+      if (c.stats.beyond > 0) what += fmt::format(", more than {} µm", Um(changes.threshold_um));
+    } else {
+      what = Stats(c.stats, changes.threshold_um);
+    }
+    text += fmt::format("Δ{}: {}: {}\n", AxisName(axis), how, what);
   }
   const std::vector<std::size_t> largest = LargestChanges(changes, kTableDiffLargest);
-  if (!largest.empty() && std::fabs(changes.nodes[largest.front()].change_um) > 0) {
+  if (!largest.empty() && Rounded(changes.nodes[largest.front()].change_um, 0.1) != 0) {
     text += "the nodes that changed most:\n";
     for (std::size_t n : largest) {
-      if (changes.nodes[n].change_um == 0) break;
+      if (Rounded(changes.nodes[n].change_um, 0.1) == 0) break;
       text += "  " + NodeText(changes.nodes[n]) + "\n";
+    }
+    // Nodes left out that changed as much as the last one listed: the list
+    // is not a ranking beyond it.
+    const double last = std::fabs(changes.nodes[largest.back()].change_um);
+    std::size_t tied = 0;
+    for (std::size_t n = 0; n < changes.nodes.size(); ++n) {
+      const bool listed = std::find(largest.begin(), largest.end(), n) != largest.end();
+      if (!listed && !changes.axes[static_cast<int>(changes.nodes[n].axis)].stats.uniform() &&
+          std::fabs(changes.nodes[n].change_um) > last - kTableDiffUniformUm) {
+        ++tied;
+      }
+    }
+    if (tied > 0 && largest.size() == kTableDiffLargest) {
+      text += fmt::format("  ... and {} more node{} by as much ({} µm)\n", tied, tied == 1 ? "" : "s",
+                          Um(last));
     }
   }
   for (const TableChanges::RegionChanges& region : changes.regions) {
@@ -99,6 +122,7 @@ std::string FormatTableDiffJson(const TableChanges& changes, const TableDiffName
     j["max_abs_um"] = RoundedToDecimals(s.max_abs_um, 4);
     j["mean_um"] = RoundedToDecimals(s.mean_um, 4);
     j["rms_um"] = RoundedToDecimals(s.rms_um, 4);
+    j["uniform"] = s.uniform();
     j["beyond_threshold"] = s.beyond;
     return j;
   };
@@ -148,9 +172,10 @@ std::string PlotTableDiffSvg(const ErrorTable& old_table, const ErrorTable& new_
   TablePlotWords words;
   words.heading = fmt::format("How the error tables changed: {} -> {}", names.old_table, names.new_table);
   words.field = "the change of the error, new - old";
-  words.arrows = "the change";
+  words.arrows = "the panel's own component of the change (along x in the Δx panel, along y in the Δy one)";
   words.panel = "change of Δ{0}";
   words.state_arrow_fill = true;
+  words.own_component = true;
   return PlotTableSvg(*change, words);
 }
 

@@ -277,6 +277,7 @@ std::string PlotTableSvg(const ErrorTable& table, const TablePlotWords& words) {
       for (std::size_t i = 0; i < t.nx(); ++i) {
         double dx = map.AxisDelta(TableAxis::X, t.xs[i], t.ys[j]);
         double dy = map.AxisDelta(TableAxis::Y, t.xs[i], t.ys[j]);
+        if (words.own_component) (p.axis == TableAxis::X ? dy : dx) = 0;
         DrawArrow(svg, p.Px(t.xs[i]), p.Py(t.ys[j]), p.Px(t.xs[i] + exaggeration * dx),
                   p.Py(t.ys[j] + exaggeration * dy));
       }

@@ -26,6 +26,7 @@ struct TablePlotWords {
   std::string arrows;      // what the arrows are: "the error vector (Δx, Δy)"
   std::string panel;       // each panel's title before its node count, {0} for the axis name: "Δ{0}: the {0} errors"
   bool state_arrow_fill = false;  // also say how long the longest arrow is drawn
+  bool own_component = false;     // each panel's arrows: its own axis's component only (Δx along x, Δy along y)
 };
 std::string PlotTableSvg(const ErrorTable& table, const TablePlotWords& words);
 

@@ -97,9 +97,11 @@ TEST(MachineModel, PosesAreWhatTheScanAcceptsWithinTheLimits) {
   SCOPED_TRACE(testing::Message() << "seed " << seed << " (SMTCAL_TEST_SEED repeats it)");
   std::mt19937_64 rng(seed);
   const cell::Cell cell = RandomCell(rng);
-  const MachineModel model(cell, cell);
+  const MachineWorld world(cell);
+  MachineModel model(cell, world);
   const cell::Fixture& board = cell.fixtures[0];
   const std::vector<BoardPose> limits = CheckLimitPoses(board);
+  model.SetPoses(0, CommonPoses({{&model, 0}}));
   const std::vector<BoardPose>& poses = model.Poses(0);
   ASSERT_EQ(poses.size(), limits.size());
   const PointCorrector robot(cell.regions);
@@ -141,7 +143,8 @@ TEST(MachineModel, ItsOwnTablesPutEveryPointWhereTheBoardDoes) {
   std::mt19937_64 rng(seed);
   for (int trial = 0; trial < 5; ++trial) {
     const cell::Cell cell = RandomCell(rng);
-    const MachineModel model(cell, cell);
+    const MachineWorld world(cell);
+    const MachineModel model(cell, world);
     const cell::Fixture& board = cell.fixtures[0];
     for (std::size_t p = 0; p < model.Poses(0).size(); ++p) {
       const Eigen::Vector2d f(test::Uniform(rng, 16, 58), test::Uniform(rng, 24, 66));
@@ -163,7 +166,8 @@ TEST(MachineModel, ARemeasuredPlacingTableMovesCommandsAndLandings) {
   cell::Cell new_cell = old_cell;
   AddToXTable(new_cell.regions[0], 0.012);  // the robot errs 12 µm further in x
   // As the diff does: both through their own tables, the robot as NEW's cell says.
-  const MachineModel old_model(old_cell, new_cell), new_model(new_cell, new_cell);
+  const MachineWorld world(new_cell);
+  const MachineModel old_model(old_cell, world), new_model(new_cell, world);
   const Eigen::Vector2d f(20, 40);
   for (std::size_t p = 0; p < old_model.Poses(0).size(); ++p) {
     const MachinePoint a = old_model.FixturePoint(0, p, f), b = new_model.FixturePoint(0, p, f);
@@ -189,7 +193,8 @@ TEST(MachineModel, ARemeasuredMarkerTableMovesTheBoardsTargets) {
   const cell::Cell old_cell = RandomCell(rng);
   cell::Cell new_cell = old_cell;
   AddToXTable(new_cell.regions[1], 0.012);  // under marker 1 only: the board seems turned
-  const MachineModel old_model(old_cell, new_cell), new_model(new_cell, new_cell);
+  const MachineWorld world(new_cell);
+  const MachineModel old_model(old_cell, world), new_model(new_cell, world);
   double largest = 0;
   for (std::size_t p = 0; p < old_model.Poses(0).size(); ++p) {
     const MachinePoint a = old_model.FixturePoint(0, p, {40, 40}), b = new_model.FixturePoint(0, p, {40, 40});
@@ -199,6 +204,84 @@ TEST(MachineModel, ARemeasuredMarkerTableMovesTheBoardsTargets) {
   // Marker 1's trips moved 12 µm: the fitted board moves by micrometres.
   EXPECT_GT(largest, 0.001);
   EXPECT_LT(largest, 0.05);
+}
+
+// One machine for both programs: OLD's cell says the board's nominal pose
+// and its scan paths are elsewhere than NEW's cell (the machine) does. Its
+// legs then run elsewhere, its trips land elsewhere on the same true edges,
+// and its runtime finds the same pose: nothing it commands moves.
+TEST(MachineModel, ANominalPoseOrScanPathOfItsOwnMovesNothing) {
+  const std::uint64_t seed = FixtureSeed();
+  SCOPED_TRACE(testing::Message() << "seed " << seed << " (SMTCAL_TEST_SEED repeats it)");
+  std::mt19937_64 rng(seed);
+  const cell::Cell new_cell = RandomCell(rng);
+  for (int change = 0; change < 3; ++change) {
+    cell::Cell old_cell = new_cell;
+    cell::Fixture& fixture = old_cell.fixtures[0];
+    if (change == 0) fixture.origin_mm += Eigen::Vector2d(0.02, -0.015);
+    if (change == 1) fixture.angle_deg += 0.01;
+    if (change == 2) {
+      for (cell::ScanPath& path : fixture.scan_paths) {
+        for (cell::Point2& point : path.points) point.y() += 0.3;  // every leg crosses its edge 0.3 mm higher
+      }
+    }
+    const MachineWorld world(new_cell);
+    MachineModel old_model(old_cell, world), new_model(new_cell, world);
+    const std::vector<BoardPose> poses = CommonPoses({{&old_model, 0}, {&new_model, 0}});
+    old_model.SetPoses(0, poses);
+    new_model.SetPoses(0, poses);
+    for (std::size_t p = 0; p < poses.size(); ++p) {
+      SCOPED_TRACE(testing::Message() << "change " << change << ", " << DescribeBoardPose(poses[p]));
+      const MachinePoint a = old_model.FixturePoint(0, p, {40, 40}), b = new_model.FixturePoint(0, p, {40, 40});
+      ASSERT_TRUE(a.ok && b.ok) << a.why << b.why;
+      EXPECT_LT((b.lands - a.lands).norm(), 1e-7);
+      // And where the board puts it.
+      EXPECT_LT((b.lands - ToBase(BoardPoseFix(new_cell.fixtures[0], poses[p]), {40, 40})).norm(), 1e-9);
+    }
+  }
+}
+
+// The board re-measured: marker 2's edges 20 µm further out (L1 + 0.02).
+// The machine's board is NEW's; OLD's runtime fits the same trips to its
+// own, older geometry and finds another pose, so every part it places moves
+// by the difference, as `smtcal fixture` on those trips with each cell says.
+TEST(MachineModel, ARemeasuredMarkerEdgeMovesEveryPartOfTheOtherProgram) {
+  const std::uint64_t seed = FixtureSeed();
+  SCOPED_TRACE(testing::Message() << "seed " << seed << " (SMTCAL_TEST_SEED repeats it)");
+  std::mt19937_64 rng(seed);
+  const cell::Cell old_cell = RandomCell(rng);
+  cell::Cell new_cell = old_cell;
+  cell::Fixture& board = new_cell.fixtures[0];
+  board.l1_mm += 0.02;
+  board.edges[2].from.x() += 0.02;
+  board.edges[2].to.x() += 0.02;
+  board.edges[3].from.x() += 0.02;
+  board.edges[3].to.x() += 0.02;
+  const MachineWorld world(new_cell);
+  MachineModel old_model(old_cell, world), new_model(new_cell, world);
+  const std::vector<BoardPose> poses = CommonPoses({{&old_model, 0}, {&new_model, 0}});
+  old_model.SetPoses(0, poses);
+  new_model.SetPoses(0, poses);
+  const PointCorrector robot(new_cell.regions);
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    SCOPED_TRACE(DescribeBoardPose(poses[p]));
+    const Eigen::Affine3d truth = BoardPoseFix(board, poses[p]);
+    // The same trips, each program's own estimate of them.
+    const std::vector<std::optional<Eigen::Vector2d>> trips = ScannedTrips(old_cell.fixtures[0], board, robot, truth);
+    ScanOptions options;
+    options.estimator = old_cell.fixtures[0].estimator;
+    options.regions = &old_cell.regions;
+    const ScanResult old_scan = ScanFixture(old_cell.fixtures[0], trips, options);
+    ASSERT_TRUE(old_scan.ok());
+    for (const Eigen::Vector2d& f : {Eigen::Vector2d(20, 30), Eigen::Vector2d(150, 70)}) {
+      const MachinePoint a = old_model.FixturePoint(0, p, f), b = new_model.FixturePoint(0, p, f);
+      ASSERT_TRUE(a.ok && b.ok) << a.why << b.why;
+      EXPECT_LT((b.lands - ToBase(truth, f)).norm(), 1e-9);  // NEW's program knows the board
+      EXPECT_LT((a.lands - ToBase(*old_scan.fix, f)).norm(), 1e-9);  // OLD's puts it where its estimate does
+      EXPECT_GT((a.lands - b.lands).norm(), 0.001);                  // micrometres apart
+      EXPECT_LT((a.lands - b.lands).norm(), 0.03);
+    }
+  }
 }
 
 }  // namespace

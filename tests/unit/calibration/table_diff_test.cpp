@@ -1,6 +1,8 @@
 // Comparing two error tables (calibration/table_diff.h): node by node on
 // one grid, through the interpolation on two, per region.
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -31,6 +33,27 @@ TEST(TableDiff, AShiftOnTheSameGridIsSeenAtEveryNode) {
   for (const NodeChange& node : changes.nodes) {
     EXPECT_TRUE(node.on_old_grid && node.on_new_grid);
   }
+}
+
+// A uniform change has no node that changed "most" (issue 40): the x axis
+// shifted alike everywhere (to within printing) is uniform and ranks no
+// node; one node changed 1 µm more than the rest is ranked first.
+TEST(TableDiff, AUniformChangeRanksNoNode) {
+  std::mt19937_64 rng(2);
+  const ErrorTable a = Table(rng);
+  ErrorTable b = a;
+  std::vector<double>& x = b[TableAxis::X].error_mm;
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] += 0.012 + (i % 2 == 0 ? 0.00000001 : 0);  // 12.00001 µm or 12
+  TableChanges changes = CompareTables(a, b, 10, nullptr);
+  EXPECT_TRUE(changes.axes[0].stats.uniform());
+  EXPECT_TRUE(LargestChanges(changes, 10).empty());
+  x[37] += 0.001;
+  changes = CompareTables(a, b, 10, nullptr);
+  EXPECT_FALSE(changes.axes[0].stats.uniform());
+  const std::vector<std::size_t> largest = LargestChanges(changes, 10);
+  ASSERT_FALSE(largest.empty());
+  EXPECT_NEAR(changes.nodes[largest.front()].change_um, 13, 1e-6);
+  EXPECT_NEAR(changes.axes[0].stats.max_um - changes.axes[0].stats.min_um, 1, 1e-6);
 }
 
 TEST(TableDiff, OnAnotherGridTheSameFieldDoesNotChange) {

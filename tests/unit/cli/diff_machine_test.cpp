@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -167,6 +168,49 @@ TEST_F(DiffOnTheMachine, ThePictureDrawsThePositionsAtTheirSpacing) {
   const double drawn_mm = std::stod(svg.substr(at + 9));
   EXPECT_GT(drawn_mm, 1.0);
   EXPECT_LT(drawn_mm, 6.0);
+}
+
+// docs/diff.md shows docs/images/diff-board.svg as what `diff --svg` draws
+// for the board re-measured (marker 2 20 µm further out, L1 190.02), run as
+// the document runs it: it must stay exactly that picture.
+// SMTCAL_UPDATE_GOLDEN=1 rewrites it (review it as a PNG before committing).
+TEST_F(DiffOnTheMachine, TheDocsPictureOfAReMeasuredBoardIsWhatDiffDraws) {
+  fs::create_directories(dir_ / "doc" / "board");
+  for (const fs::directory_entry& entry : fs::directory_iterator(kExample)) {
+    if (entry.path().extension() == ".csv" || entry.path().extension() == ".toml" ||
+        entry.path().extension() == ".place") {
+      fs::copy_file(entry.path(), dir_ / "doc" / entry.path().filename(), fs::copy_options::overwrite_existing);
+      if (entry.path().extension() != ".place") {
+        fs::copy_file(entry.path(), dir_ / "doc" / "board" / entry.path().filename(),
+                      fs::copy_options::overwrite_existing);
+      }
+    }
+  }
+  std::string cell = ReadFileText(dir_ / "doc" / "board" / "paper.cell.toml");
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\nl1_mm = 190\n", "\nl1_mm = 190.02\n"},
+                                 {"[190, 82], to_mm = [190, 90]", "[190.02, 82], to_mm = [190.02, 90]"},
+                                 {"[182, 90], to_mm = [190, 90]", "[182.02, 90], to_mm = [190.02, 90]"}}) {
+    const std::size_t at = cell.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    cell.replace(at, from.size(), to);
+  }
+  std::ofstream(dir_ / "doc" / "board" / "paper.cell.toml", std::ios::binary) << cell;
+  for (const std::string& command : {std::string("compile layers.place --cell paper.cell.toml -o old.place"),
+                                     std::string("compile layers.place --cell board/paper.cell.toml -o board.place")}) {
+    SmtcalRun run = RunSmtcal(command, dir_ / "doc");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  SmtcalRun run = RunSmtcal("diff old.place board.place --svg board.svg", dir_ / "doc");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  const fs::path picture = fs::path(SMTCAL_SOURCE_DIR) / "docs" / "images" / "diff-board.svg";
+  const std::string svg = ReadFileText(dir_ / "doc" / "board.svg");
+  const char* update = std::getenv("SMTCAL_UPDATE_GOLDEN");
+  if (update != nullptr && std::string(update) == "1") {
+    std::ofstream(picture, std::ios::binary) << svg;
+    return;
+  }
+  EXPECT_EQ(svg, ReadFileText(picture))
+      << "docs/images/diff-board.svg is not what `smtcal diff --svg` draws; rewrite it with SMTCAL_UPDATE_GOLDEN=1";
 }
 
 TEST_F(DiffOnTheMachine, LinuxCncOutputsTakeNoCell) {

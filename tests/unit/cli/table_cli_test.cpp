@@ -129,10 +129,14 @@ TEST_F(TableCli, DiffDrawsTheChangeAndGatesOnTheThreshold) {
   CliRun gate = Smtcal(fmt::format("table diff {} {} --svg {}", kTable, shifted.string(), picture.string()));
   EXPECT_EQ(gate.exit_code, 1) << gate.err;
   EXPECT_NE(gate.out.find("Δy: 121 nodes of the same grid"), std::string::npos) << gate.out;
-  EXPECT_NE(gate.out.find("max |change| 20.0 µm, mean +20.0 µm"), std::string::npos) << gate.out;
+  // Every node moved alike: a uniform change, no node listed as changed "most".
+  EXPECT_NE(gate.out.find("a uniform change: every node +20.0 µm, more than 10.0 µm"), std::string::npos)
+      << gate.out;
+  EXPECT_EQ(gate.out.find("the nodes that changed most"), std::string::npos) << gate.out;
   const std::string svg = ReadFileText(picture);
   EXPECT_EQ(svg.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0), 0u);
   EXPECT_NE(svg.find("change of Δy, 11 x 11 nodes"), std::string::npos);
+  EXPECT_NE(svg.find("the panel's own component of the change"), std::string::npos);
   EXPECT_NE(svg.find("µm"), std::string::npos);
   EXPECT_EQ(Smtcal(fmt::format("table diff {} {} --threshold 20.5", kTable, shifted.string())).exit_code, 0);
   EXPECT_EQ(Smtcal(fmt::format("table diff {} {} --exit-zero", kTable, shifted.string())).exit_code, 0);

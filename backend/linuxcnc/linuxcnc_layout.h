@@ -1,7 +1,8 @@
 // The layout of the LinuxCNC runtime's data in its numbered parameters
-// (runtime/linuxcnc/README.md, "Parameter layout"): written by
-// backend/linuxcnc/linuxcnc_data.h into smtcal_data.ngc, read back by
-// frontend/linuxcnc_output.h for `smtcal diff`.
+// (runtime/linuxcnc/README.md, "Parameter layout"), and how a main program
+// tells the runtime to command a position: written by linuxcnc_data.h into
+// smtcal_data.ngc and by linuxcnc_emit.h into the main program, read back by
+// linuxcnc_output.h for `smtcal diff`.
 #pragma once
 
 #include <string_view>
@@ -25,6 +26,12 @@ inline constexpr int kLayoutVersion = 1;
 // The named parameter smtcal_data.ngc sets to the runtime's identity (the
 // main program checks it before its first move; not part of the cell).
 inline constexpr std::string_view kRuntimeIdParameter = "#<_smtcal_runtime_id>";
+// The first argument of o<pick_place> and o<smtcal_correct> besides a
+// fixture's index in the data (0, 1, ...: a point in that fixture's frame,
+// through FIX and the tables): a base position the runtime corrects through
+// the error tables, or a position commanded as given.
+inline constexpr int kCommandBase = -1;
+inline constexpr int kCommandAsWritten = -2;
 
 // Fixture record offsets.
 inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 3, kFxSin = 4, kFxL1 = 5,

@@ -1,24 +1,37 @@
-// Reading back a LinuxCNC output (frontend/linuxcnc_output.h).
+// Reading back a LinuxCNC output (backend/linuxcnc/linuxcnc_output.h).
 //
-// The data: smtcal_data.ngc is a list of `#N = number  ; what` lines inside
-// `o<smtcal_data> sub`; its numbers are decoded with the layout the writer
-// uses (frontend/linuxcnc_layout.h) into regions (bounds, policy, tables,
+// The runtime's folder. smtcal_data.ngc is a list of `#N = number  ; what`
+// lines inside `o<smtcal_data> sub`; its numbers are decoded with the layout
+// the runtime reads (linuxcnc_layout.h) into regions (bounds, policy, tables,
 // validated) and fixtures (nominal pose, limits, estimator, marker edge
 // lines, scan paths), the names taken from the `what` comments. A fixture's
-// edge segments are rebuilt on their lines over the trips the data says
-// each edge has, and the expected trips recomputed from them must be the
-// data's own, or the file is refused.
+// edge segments are rebuilt on their lines over the trips the data says each
+// edge has, and the expected trips recomputed from them must be the data's
+// own. Then the data is written again from what was decoded
+// (EmitLinuxCncData) and compared line by line: every line the runtime
+// reads — the derived numbers (domains, contraction, iteration bound, trip
+// positions), the runtime's switches (#37: a failed scan aborts) and initial
+// state, the comments — must be the emitter's, a number up to the rounding
+// of the geometry decoded (kRoundingRel). Last, the runtime id the data
+// records must be the one its text gives (LinuxCncRuntimeIdOf): a changed
+// byte anywhere in the runtime's folder changes it. The runtime's own files
+// must be this smtcal's, and the files written for the cell (scan abort
+// messages, cycle record) what the emitter writes for the cell decoded.
 //
-// The main program: every form the emitter writes (backend/linuxcnc/
-// linuxcnc_emit.cpp) is recognised line by line and written back as the
-// .place statement it lowers — literal targets as XY(...), point parameters
-// as the point (in its root frame: Local frames are folded in), temporaries
-// as the point or pallet slot and its offsets, For, If, Wait Sw, Cycle,
-// Scan, Call — and that text is parsed and checked like any program. The
-// variables' types (the G-code has none) are inferred: a variable is Real
-// when anything assigned to it is. Line numbers of the text are mapped back
-// to the .ngc file's, so a diff names the lines of the program that runs.
-#include "frontend/linuxcnc_output.h"
+// The main program: every form the emitter writes (linuxcnc_emit.cpp) is
+// recognised line by line and written back as the .place statement it
+// lowers — literal targets as XY(...), point parameters as the point (in its
+// root frame: Local frames are folded in), temporaries as the point or
+// pallet slot and its offsets, For, If, Wait Sw, Cycle, Scan, Call — and
+// that text is parsed and checked like any program. The variables' types
+// (the G-code has none) are inferred: a variable is Real when anything
+// assigned to it is. Line numbers of the text are mapped back to the .ngc
+// file's, so a diff names the lines of the program that runs. The
+// o<pick_place> subroutine must be the emitter's for the wiring it names;
+// each motion's first call argument (how the runtime commands it) is kept
+// for CheckLinuxCncCommands. Blocks and brackets nest at most kMaxNesting
+// deep (the .place parser's own bound on blocks).
+#include "backend/linuxcnc/linuxcnc_output.h"
 
 #include <algorithm>
 #include <cctype>
@@ -30,16 +43,35 @@
 
 #include <fmt/format.h>
 
+#include "backend/linuxcnc/embedded_files.h"
+#include "backend/linuxcnc/linuxcnc_data.h"
+#include "backend/linuxcnc/linuxcnc_emit.h"
+#include "backend/linuxcnc/linuxcnc_layout.h"
+#include "backend/linuxcnc/linuxcnc_record.h"
+#include "backend/linuxcnc/linuxcnc_scan_abort.h"
 #include "base/check.h"
 #include "calibration/error_table_check.h"
 #include "calibration/fixture_geometry.h"
-#include "frontend/linuxcnc_layout.h"
+#include "ir/constant_fold.h"
+#include "ir/ir_walk.h"
+#include "ir/symbols.h"
 
 namespace smtcal {
 namespace {
 
 namespace fs = std::filesystem;
 namespace L = linuxcnc_layout;
+
+// How deep blocks (Cycle, For, If) and brackets may nest in a main program
+// read back: the .place parser's bound on blocks (frontend/parse.cpp), so
+// whatever is read can be parsed again; the recursion stays shallow.
+constexpr int kMaxNesting = 100;
+// Two numbers of a data line agree when they differ by at most this much of
+// their size (or of 1): the rounding of what the decoded geometry gives back
+// (an edge's line rebuilt from its normal, a path point through the nominal
+// pose and back); anything a hand edit changes is far more, and the runtime
+// id catches the rest.
+constexpr double kRoundingRel = 1e-9;
 
 // ------------------------------------------------------------------ errors
 
@@ -49,16 +81,104 @@ struct ReadError {
   std::string what;
 };
 
-// ------------------------------------------------------------------ the data
+// ------------------------------------------------------------------ text
 
+// A finite number written as the emitter writes them (no exponent).
 std::optional<double> ParseNumber(std::string_view text) {
   if (text.empty()) return std::nullopt;
   double value = 0;
   const char* end = text.data() + text.size();
   auto [ptr, ec] = std::from_chars(text.data(), end, value, std::chars_format::fixed);
-  if (ec != std::errc() || ptr != end) return std::nullopt;
+  if (ec != std::errc() || ptr != end || !std::isfinite(value)) return std::nullopt;
   return value;
 }
+
+// Line `i` (0-based) of a file, without its line end.
+std::string_view LineOf(const SourceFile& file, std::size_t i) {
+  const std::size_t begin = file.line_starts[i];
+  const std::size_t end = i + 1 < file.line_starts.size() ? file.line_starts[i + 1] : file.text.size();
+  std::string_view line(file.text.data() + begin, end - begin);
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
+  return line;
+}
+
+// The lines of a text (the newline at the end does not open another).
+std::vector<std::string_view> LinesOf(std::string_view text) {
+  std::vector<std::string_view> lines;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(at, end - at);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines.push_back(line);
+    at = end + 1;
+  }
+  return lines;
+}
+
+// A line quoted in a message: cut, printable.
+std::string Shown(std::string_view line) {
+  std::string out;
+  for (char c : line.substr(0, 100)) out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+  if (line.size() > 100) out += "...";
+  return out;
+}
+
+// "#N = value  ; what" split into its address text, value and comment.
+struct ParamLine {
+  std::string_view address, value, what;
+};
+std::optional<ParamLine> SplitParamLine(std::string_view line) {
+  if (!line.starts_with('#')) return std::nullopt;
+  const std::size_t eq = line.find(" = ");
+  if (eq == std::string_view::npos) return std::nullopt;
+  ParamLine param{line.substr(0, eq), line.substr(eq + 3), {}};
+  if (const std::size_t semicolon = param.value.find("  ; "); semicolon != std::string_view::npos) {
+    param.what = param.value.substr(semicolon);
+    param.value = param.value.substr(0, semicolon);
+  }
+  return param;
+}
+
+// The first line of `file` that is not `expected`'s (nullopt when they are
+// the same). With `rounding`, two parameter lines of the same address and
+// comment whose numbers agree to kRoundingRel are the same. A line starting
+// with `skip` is left out on both sides.
+std::optional<ReadError> FirstDifference(const SourceFile& file, std::string_view expected, bool rounding,
+                                         std::string_view skip = {}) {
+  std::vector<std::string_view> want = LinesOf(expected);
+  std::vector<std::pair<std::uint32_t, std::string_view>> have;
+  for (std::size_t i = 0; i < file.line_starts.size(); ++i) {
+    std::string_view line = LineOf(file, i);
+    if (line.empty() && i + 1 == file.line_starts.size() && file.text.ends_with('\n')) break;
+    if (!skip.empty() && line.starts_with(skip)) continue;
+    have.emplace_back(static_cast<std::uint32_t>(i + 1), line);
+  }
+  if (!skip.empty()) std::erase_if(want, [&](std::string_view line) { return line.starts_with(skip); });
+  for (std::size_t i = 0; i < std::max(want.size(), have.size()); ++i) {
+    if (i >= have.size()) {
+      return ReadError{have.empty() ? 1 : have.back().first,
+                       fmt::format("it ends where smtcal writes '{}'", Shown(want[i]))};
+    }
+    if (i >= want.size()) return ReadError{have[i].first, "a line after the end of what smtcal writes"};
+    if (have[i].second == want[i]) continue;
+    if (rounding) {
+      std::optional<ParamLine> a = SplitParamLine(have[i].second), b = SplitParamLine(want[i]);
+      if (a && b && a->address == b->address && a->what == b->what) {
+        std::optional<double> x = ParseNumber(a->value), y = ParseNumber(b->value);
+        if (x && y && std::fabs(*x - *y) <= kRoundingRel * std::max({1.0, std::fabs(*x), std::fabs(*y)})) continue;
+      }
+    }
+    return ReadError{have[i].first, fmt::format("smtcal writes '{}' here{}", Shown(want[i]),
+                                                rounding ? " for the data as read: this line or one it is "
+                                                           "computed from was changed"
+                                                         : "")};
+  }
+  return std::nullopt;
+}
+
+// ------------------------------------------------------------------ the data
 
 struct DataParam {
   double value = 0;
@@ -68,28 +188,33 @@ struct DataParam {
 
 class DataReader {
  public:
-  DataReader(const SourceFile& file) : file_(file) {}
+  explicit DataReader(const SourceFile& file) : file_(file) {}
 
   std::optional<ReadError> Read(cell::Cell& cell) {
     if (auto error = ReadLines(cell)) return error;
     const int regions = Integer(L::kRegionCount), fixtures = Integer(L::kFixtureCount);
     if (!error_.what.empty()) return error_;
+    if (regions < 0 || fixtures < 0 || regions > L::kScratch || fixtures > L::kScratch) {
+      return ReadError{Where(L::kRegionCount), "a region or fixture count out of range"};
+    }
     for (int r = 0; r < regions && error_.what.empty(); ++r) ReadRegion(Integer(Integer(L::kRegionDirectory) + r), r, cell);
     for (int k = 0; k < fixtures && error_.what.empty(); ++k) {
       ReadFixture(Integer(Integer(L::kFixtureDirectory) + k), Integer(L::kFixtureDirectory) + k, cell);
     }
+    cell.robot.safe_limz_mm = Value(L::kSafeZ);
     if (!error_.what.empty()) return error_;
-    safe_z_ = Value(L::kSafeZ);
     return std::nullopt;
   }
-  double safe_z() const { return safe_z_; }
+  // The runtime id the data sets, and its line (0: none).
+  long id() const { return id_; }
+  std::uint32_t id_line() const { return id_line_; }
 
  private:
   std::optional<ReadError> ReadLines(cell::Cell& cell) {
     bool in_sub = false, ended = false;
     for (std::size_t i = 0; i < file_.line_starts.size(); ++i) {
       const auto number = static_cast<std::uint32_t>(i + 1);
-      std::string_view line = Line(i);
+      std::string_view line = LineOf(file_, i);
       if (line.empty() && i + 1 == file_.line_starts.size()) break;  // the newline at the end
       if (ended) return ReadError{number, "text after o<smtcal_data> endsub"};
       if (line.starts_with(";")) {
@@ -117,24 +242,28 @@ class DataReader {
         continue;
       }
       // The cycle record's begin line (smtcal_record_open.ngc, written for the
-      // cell): no data of the cell.
+      // cell): no data of the cell (the comparison with the emitter's text
+      // holds it to its place).
       if (in_sub && line.starts_with("o<smtcal_record_open> call")) continue;
       if (!in_sub || !line.starts_with('#')) return ReadError{number, "a line that is not a parameter of o<smtcal_data>"};
-      if (line.starts_with(L::kRuntimeIdParameter)) continue;  // the runtime's identity, not the cell's data
-      // #N = value[  ; what]
-      const std::size_t eq = line.find(" = ");
-      if (eq == std::string_view::npos) return ReadError{number, "a parameter line without ' = '"};
-      std::string_view rest = line.substr(eq + 3);
-      std::string_view what;
-      if (const std::size_t semicolon = rest.find("  ; "); semicolon != std::string_view::npos) {
-        what = rest.substr(semicolon + 4);
-        rest = rest.substr(0, semicolon);
+      std::optional<ParamLine> param = SplitParamLine(line);
+      if (!param) return ReadError{number, "a parameter line without ' = '"};
+      if (param->address == L::kRuntimeIdParameter) {  // the runtime's identity, checked on its own
+        std::optional<double> id = ParseNumber(param->value);
+        if (!id || *id != std::floor(*id) || *id < 0 || *id > 0x7fffffff || id_line_ != 0) {
+          return ReadError{number, "a runtime id that is not the one whole number smtcal writes"};
+        }
+        id_ = static_cast<long>(*id);
+        id_line_ = number;
+        continue;
       }
-      std::optional<double> address = ParseNumber(line.substr(1, eq - 1));
-      std::optional<double> value = ParseNumber(rest);
+      std::optional<double> address = ParseNumber(param->address.substr(1));
+      std::optional<double> value = ParseNumber(param->value);
       if (!address || !value || *address != std::floor(*address) || *address < L::kFirst || *address >= L::kScratch) {
         return ReadError{number, "a parameter line whose address or value is not a plain number in the data's range"};
       }
+      std::string_view what = param->what;
+      if (what.starts_with("  ; ")) what.remove_prefix(4);
       params_[static_cast<int>(*address)] = {*value, number, std::string(what)};
     }
     if (!ended) return ReadError{static_cast<std::uint32_t>(file_.line_starts.size()), "no o<smtcal_data> endsub"};
@@ -142,14 +271,6 @@ class DataReader {
       return ReadError{Where(L::kVersion), fmt::format("the layout version is not {}", L::kLayoutVersion)};
     }
     return std::nullopt;
-  }
-
-  std::string_view Line(std::size_t i) const {
-    const std::size_t begin = file_.line_starts[i];
-    const std::size_t end = i + 1 < file_.line_starts.size() ? file_.line_starts[i + 1] : file_.text.size();
-    std::string_view line(file_.text.data() + begin, end - begin);
-    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
-    return line;
   }
 
   std::uint32_t Where(int address) const {
@@ -171,8 +292,17 @@ class DataReader {
   }
   int Integer(int address) {
     const double value = Value(address);
-    if (value != std::floor(value) || std::fabs(value) > 1e6) Fail(address, fmt::format("#{} is not a whole number", address));
+    if (value != std::floor(value) || std::fabs(value) > 1e6) {
+      Fail(address, fmt::format("#{} is not a whole number", address));
+      return 0;
+    }
     return static_cast<int>(value);
+  }
+  // A length, limit or speed that must be above 0.
+  double Positive(int address) {
+    const double value = Value(address);
+    if (!(value > 0)) Fail(address, fmt::format("#{} is not above 0", address));
+    return value;
   }
   // The name in a "what" comment "<prefix>NAME<suffix>".
   std::string Name(int address, std::string_view prefix, std::string_view suffix) {
@@ -188,8 +318,8 @@ class DataReader {
   AxisTable ReadTable(int at) {
     AxisTable table;
     const int nx = Integer(at), ny = Integer(at + 1);
-    if (nx < 2 || ny < 2 || nx * ny > L::kScratch) {
-      Fail(at, "a table smaller than 2 x 2 nodes");
+    if (nx < 2 || ny < 2 || nx > L::kScratch || ny > L::kScratch || nx * ny > L::kScratch) {
+      Fail(at, "a table smaller than 2 x 2 nodes or larger than the data");
       return table;
     }
     for (int i = 0; i < nx; ++i) table.xs.push_back(Value(at + 2 + i));
@@ -221,7 +351,18 @@ class DataReader {
       return;
     }
     region.domain = TableDomain(region.table);
+    if (!(region.x_mm.lo < region.x_mm.hi) || !(region.y_mm.lo < region.y_mm.hi)) {
+      Fail(at, fmt::format("the bounds of region {} are empty", region.name));
+      return;
+    }
     cell.regions.push_back(std::move(region));
+  }
+
+  // A unit vector of the data (a normal, the nominal pose's cos and sin).
+  Eigen::Vector2d Unit(int address) {
+    const Eigen::Vector2d v(Value(address), Value(address + 1));
+    if (std::fabs(v.norm() - 1) > kRoundingRel) Fail(address, fmt::format("#{} and #{} are not a unit vector", address, address + 1));
+    return v;
   }
 
   void ReadFixture(int at, int directory_entry, cell::Cell& cell) {
@@ -232,18 +373,20 @@ class DataReader {
     if (estimator < 0 || estimator > 2) Fail(at + L::kFxEstimator, "an estimator that is not 0, 1 or 2");
     fixture.estimator = static_cast<cell::Estimator>(std::clamp(estimator, 0, 2));
     fixture.origin_mm = {Value(at + L::kFxOriginX), Value(at + L::kFxOriginY)};
-    fixture.angle_deg = std::atan2(Value(at + L::kFxSin), Value(at + L::kFxCos)) * kDegPerRad;
-    fixture.l1_mm = Value(at + L::kFxL1);
-    fixture.l2_mm = Value(at + L::kFxL2);
-    fixture.trip_window_mm = Value(at + L::kFxTripWindow);
-    fixture.max_shift_mm = Value(at + L::kFxMaxShift);
-    fixture.max_rotation_deg = Value(at + L::kFxMaxRotation);
-    fixture.length_tolerance_mm = Value(at + L::kFxLengthTolerance);
-    fixture.squareness_deg = Value(at + L::kFxSquareness);
-    fixture.max_line_residual_mm = Value(at + L::kFxMaxLineResidual);
+    const Eigen::Vector2d cos_sin = Unit(at + L::kFxCos);
+    fixture.angle_deg = std::atan2(cos_sin.y(), cos_sin.x()) * kDegPerRad;
+    fixture.l1_mm = Positive(at + L::kFxL1);
+    fixture.l2_mm = Positive(at + L::kFxL2);
+    fixture.trip_window_mm = Positive(at + L::kFxTripWindow);
+    fixture.max_shift_mm = Positive(at + L::kFxMaxShift);
+    fixture.max_rotation_deg = Positive(at + L::kFxMaxRotation);
+    fixture.length_tolerance_mm = Positive(at + L::kFxLengthTolerance);
+    fixture.squareness_deg = Positive(at + L::kFxSquareness);
+    fixture.max_line_residual_mm = Positive(at + L::kFxMaxLineResidual);
     fixture.scan_z_mm = Value(at + L::kFxScanZ);
-    fixture.scan_speed_mm_s = Value(at + L::kFxScanFeed) / 60;
+    fixture.scan_speed_mm_s = Positive(at + L::kFxScanFeed) / 60;
     fixture.latch_speed_mm_s = Value(at + L::kFxLatchFeed) / 60;  // 0: one stage
+    if (fixture.latch_speed_mm_s < 0) Fail(at + L::kFxLatchFeed, "a latch feed below 0");
     const int trips = Integer(at + L::kFxTripCount);
     if (trips < 1 || trips > 64) Fail(at + L::kFxTripCount, "a trip count out of range");
     if (!error_.what.empty()) return;
@@ -257,8 +400,8 @@ class DataReader {
       trip_at.push_back(ToFixtureFrame(nominal, {Value(nominal_at + 2 * k), Value(nominal_at + 2 * k + 1)}));
     }
     // Each edge as the segment of its line that spans its trips.
-    for (int e = 0; e < 4; ++e) {
-      const Eigen::Vector2d normal(Value(at + L::kFxEdgeNormal + 2 * e), Value(at + L::kFxEdgeNormal + 2 * e + 1));
+    for (int e = 0; e < 4 && error_.what.empty(); ++e) {
+      const Eigen::Vector2d normal = Unit(at + L::kFxEdgeNormal + 2 * e);
       const double offset = Value(at + L::kFxEdgeOffset + e);
       const Eigen::Vector2d along(normal.y(), -normal.x());  // EdgeLineOf turns the direction left into the normal
       const Eigen::Vector2d on_line = normal * offset;
@@ -279,9 +422,11 @@ class DataReader {
       edge.from = on_line + along * (lo - kSpanMarginMm);
       edge.to = on_line + along * (hi + kSpanMarginMm);
     }
+    if (!error_.what.empty()) return;
     // The scan paths, from the base frame at the nominal pose.
     const int paths_at = Integer(at + L::kFxScanPathsAt);
     const int paths = Integer(paths_at);
+    if (paths < 1 || paths > 64) Fail(paths_at, "a scan path count out of range");
     int next = paths_at + 1;
     for (int p = 0; p < paths && error_.what.empty(); ++p) {
       cell::ScanPath path;
@@ -289,9 +434,10 @@ class DataReader {
       const std::string what = Name(next, prefix, " point count");
       path.name = what;
       const int points = Integer(next++);
-      if (points < 2 || points > 1000) Fail(next - 1, "a scan path with fewer than 2 points");
+      if (points < 2 || points > 1000) Fail(next - 1, "a scan path with fewer than 2 or more than 1000 points");
       for (int i = 0; i < points && error_.what.empty(); ++i, next += 3) {
         path.points.push_back(ToFixtureFrame(nominal, {Value(next), Value(next + 1)}));
+        if (i > 0 && (path.points[i] - path.points[i - 1]).norm() == 0) Fail(next, "a scan path point repeated");
       }
       fixture.scan_paths.push_back(std::move(path));
     }
@@ -313,8 +459,39 @@ class DataReader {
   const SourceFile& file_;
   std::map<int, DataParam> params_;
   ReadError error_;
-  double safe_z_ = 0;
+  long id_ = -1;
+  std::uint32_t id_line_ = 0;
 };
+
+// ------------------------------------------------------------------ the cycle record
+
+// The cycle record's settings ([linuxcnc] record_file, record_max_cycles,
+// record_clock_pin) as the files written for them name them; the comparison
+// with the emitter's text checks every line.
+void DecodeRecord(const SourceFile& record_open, const SourceFile& record, cell::LinuxCnc& linuxcnc) {
+  const std::string_view open = record_open.text, rec = record.text;
+  constexpr std::string_view kAppend = "(LOGAPPEND,";
+  if (const std::size_t at = open.find(kAppend); at != std::string_view::npos) {
+    const std::size_t end = open.find(')', at);
+    if (end != std::string_view::npos) linuxcnc.record_file = std::string(open.substr(at + kAppend.size(), end - at - kAppend.size()));
+  }
+  constexpr std::string_view kClock = " clock=";
+  if (const std::size_t at = open.find(kClock); at != std::string_view::npos) {
+    const std::size_t end = open.find(' ', at + kClock.size());
+    const std::string_view pin = open.substr(at + kClock.size(), end == std::string_view::npos ? 0 : end - at - kClock.size());
+    linuxcnc.record_clock_pin = pin == "none" ? std::string() : std::string(pin);
+  }
+  const std::string full = fmt::format("if [#{} GE ", L::kRecordCount);
+  if (const std::size_t at = rec.find(full); at != std::string_view::npos) {
+    const std::size_t end = rec.find(']', at);
+    if (end != std::string_view::npos) {
+      std::optional<double> cycles = ParseNumber(rec.substr(at + full.size(), end - at - full.size()));
+      if (cycles && *cycles >= 1 && *cycles <= 1e9 && *cycles == std::floor(*cycles)) {
+        linuxcnc.record_max_cycles = static_cast<int>(*cycles);
+      }
+    }
+  }
+}
 
 // ------------------------------------------------------------------ G-code expressions
 
@@ -334,6 +511,11 @@ class GParser {
   std::optional<GNode> Expr() {
     Skip();
     if (at_ >= text_.size()) return std::nullopt;
+    // Brackets nest at most kMaxNesting deep: the recursion stays shallow.
+    if (depth_ >= kMaxNesting) {
+      too_deep_ = true;
+      return std::nullopt;
+    }
     const char c = text_[at_];
     if (c == '[') return Group();
     if (c == '#') {
@@ -380,11 +562,19 @@ class GParser {
     Skip();
     return at_ >= text_.size();
   }
+  // Whether an expression failed for nesting deeper than kMaxNesting.
+  bool too_deep() const { return too_deep_; }
   std::size_t position() const { return at_; }
 
  private:
   std::optional<GNode> Group() {
     ++at_;  // [
+    ++depth_;
+    std::optional<GNode> group = GroupBody();
+    --depth_;
+    return group;
+  }
+  std::optional<GNode> GroupBody() {
     GNode node;
     node.kind = GNode::Kind::kGroup;
     std::optional<GNode> first = Expr();
@@ -416,11 +606,15 @@ class GParser {
 
   std::string_view text_;
   std::size_t at_ = 0;
+  int depth_ = 0;
+  bool too_deep_ = false;
 };
 
-std::optional<GNode> ParseGExpr(std::string_view text) {
+// `*too_deep` (when given) says whether it failed for brackets nested too deep.
+std::optional<GNode> ParseGExpr(std::string_view text, bool* too_deep = nullptr) {
   GParser parser(text);
   std::optional<GNode> node = parser.Expr();
+  if (too_deep != nullptr) *too_deep = parser.too_deep();
   if (!node || !parser.AtEnd()) return std::nullopt;
   return node;
 }
@@ -452,6 +646,7 @@ struct PExpr {
 // removed) and its comment.
 struct NgcLine {
   std::uint32_t number = 0;
+  std::string raw;  // the line as written (without its line end)
   std::string block;
   std::string comment;  // inside the trailing parentheses, or the whole comment line's
   bool comment_only = false;
@@ -474,6 +669,7 @@ class Decompiler {
       if (text.empty() && i + 1 == ngc.line_starts.size()) break;
       NgcLine line;
       line.number = static_cast<std::uint32_t>(i + 1);
+      line.raw = std::string(LineOf(ngc, i));
       if (text.starts_with('(') && text.ends_with(')')) {
         line.comment_only = true;
         line.comment = std::string(text.substr(1, text.size() - 2));
@@ -487,8 +683,25 @@ class Decompiler {
     }
   }
 
-  // The .place text and, per line of it, the .ngc line it stands for.
-  std::optional<ReadError> Run(std::string& text, std::vector<std::uint32_t>& map) {
+  // What the main program gives of the cell besides the data: the robot's
+  // final approach and Move feed, the [linuxcnc] wiring (rotation axis,
+  // vacuum sensor), as its moves and its o<pick_place> write them.
+  struct Wiring {
+    std::optional<char> axis;
+    std::optional<double> move_feed;              // G1 F, mm/min
+    std::optional<Eigen::Vector2d> approach;      // the final approach of a Jump or o<pick_place>
+    bool approach_seen = false;                   // a Jump or o<pick_place> said whether there is one
+    std::optional<int> vacuum_sensor;
+    std::optional<double> vacuum_timeout_s;
+  };
+  const Wiring& wiring() const { return wiring_; }
+  // The runtime id the main program checks for, and the line.
+  long runtime_id() const { return runtime_id_; }
+  std::uint32_t runtime_id_line() const { return runtime_id_line_; }
+
+  // The .place text and, per line of it, the .ngc line it stands for and
+  // how the runtime commands the position of its motion.
+  std::optional<ReadError> Run(std::string& text, std::vector<std::uint32_t>& map, std::vector<int>& commands) {
     // Types settle in a few rounds: each one may find another variable Real.
     for (int round = 0; round < 8; ++round) {
       const std::map<std::string, Type> before = types_;
@@ -501,17 +714,19 @@ class Decompiler {
     }
     text = std::move(out_);
     map = std::move(map_);
+    commands = std::move(commands_);
     return std::nullopt;
   }
 
  private:
   // ---------------------------------------------------------------- output
 
-  void Emit(std::string line, std::uint32_t ngc_line) {
+  void Emit(std::string line, std::uint32_t ngc_line, int command = kNoLinuxCncCommand) {
     out_ += std::string(static_cast<std::size_t>(indent_) * 2, ' ');
     out_ += line;
     out_ += '\n';
     map_.push_back(ngc_line);
+    commands_.push_back(command);
   }
 
   [[noreturn]] void Fail(const NgcLine& line, std::string what) const { throw Failure{{line.number, std::move(what)}}; }
@@ -537,14 +752,21 @@ class Decompiler {
   void Decompile() {
     out_.clear();
     map_.clear();
+    commands_.clear();
     at_ = 0;
     indent_ = 0;
+    depth_ = 0;
+    in_cycle_ = false;
+    wiring_ = {};
+    pick_place_sub_ = false;
+    pick_place_used_ = 0;
     switches_.clear();
     pallets_.clear();
     pallet_lines_.clear();
     assigned_real_.clear();
     std::string functions_text;
     std::vector<std::uint32_t> functions_map;
+    std::vector<int> functions_commands;
 
     const NgcLine& header = Next();
     if (!header.comment_only || !header.comment.starts_with("smtcal ") ||
@@ -560,8 +782,18 @@ class Decompiler {
     const std::string id(L::kRuntimeIdParameter);
     for (const std::string& condition : {" if [EXISTS[" + id + "] EQ 0]", " if [" + id + " NE "}) {
       const NgcLine& check = Next();
-      if (!check.block.starts_with('o') || check.block.find(condition) == std::string::npos) {
+      const std::size_t found = check.block.find(condition);
+      if (!check.block.starts_with('o') || found == std::string::npos) {
         Fail(check, "the main program without its runtime check");
+      }
+      if (condition.ends_with(" NE ")) {  // the id it checks for
+        std::string_view value = std::string_view(check.block).substr(found + condition.size());
+        std::optional<double> number = value.ends_with(']') ? ParseNumber(value.substr(0, value.size() - 1)) : std::nullopt;
+        if (!number || *number != std::floor(*number) || *number < 0 || *number > 0x7fffffff) {
+          Fail(check, "a runtime check for something other than a runtime id");
+        }
+        runtime_id_ = static_cast<long>(*number);
+        runtime_id_line_ = check.number;
       }
       if (!Next().comment.starts_with("abort,")) Fail(lines_[at_ - 1], "a runtime check without its abort");
       if (!Next().block.ends_with(" endif")) Fail(lines_[at_ - 1], "a runtime check without its endif");
@@ -586,19 +818,19 @@ class Decompiler {
       globals.emplace_back(name, line.number);
     }
     // The Pick/Place subroutine, the same in every output of a cell.
-    if (Peek().comment_only && Peek().comment.starts_with("Pick and Place:")) {
-      while (Peek().block != "o<pick_place> endsub") Next();
-      Next();
-    }
+    if (Peek().comment_only && Peek().comment.starts_with("Pick and Place:")) PickPlaceSubroutine();
     // The functions.
     std::swap(out_, functions_text);
     std::swap(map_, functions_map);
+    std::swap(commands_, functions_commands);
     while (Peek().block.starts_with("o<fn_") && Peek().block.ends_with("> sub")) ReadFunction();
     std::swap(out_, functions_text);
     std::swap(map_, functions_map);
+    std::swap(commands_, functions_commands);
     Expect("o<fn_main> call");
     Expect("M2");
     if (at_ != lines_.size()) Fail(lines_[at_], "text after M2");
+    if (pick_place_used_ != 0 && !pick_place_sub_) FailAt(pick_place_used_, "o<pick_place> called, and the program does not define it");
 
     // The declarations, then the functions.
     Emit("Program " + program_name_, header_line);
@@ -610,6 +842,102 @@ class Decompiler {
     for (const auto& [name, line] : globals) Emit(fmt::format("{} {}", TypeName(name), name), line);
     out_ += functions_text;
     map_.insert(map_.end(), functions_map.begin(), functions_map.end());
+    commands_.resize(map_.size() - functions_map.size(), kNoLinuxCncCommand);
+    commands_.insert(commands_.end(), functions_commands.begin(), functions_commands.end());
+  }
+
+  // The o<pick_place> subroutine: the wiring it names (the vacuum sensor and
+  // its timeout, the rotation axis, the final approach) read from its moves
+  // and waits, then the whole of it, comments included, as the emitter
+  // writes it for that wiring (LinuxCncPickPlaceSubroutine).
+  void PickPlaceSubroutine() {
+    const NgcLine& first = Peek();
+    constexpr int kMaxSubroutineLines = 40;
+    int read = 0;
+    std::string text;
+    std::string where;
+    while (true) {
+      const NgcLine& line = Next();
+      text += line.raw;
+      text += '\n';
+      const std::string& b = line.block;
+      if (b.starts_with("M66 P") && b.find(" L3 Q") != std::string::npos) {  // M66 P<sensor> L3 Q<timeout>
+        const std::size_t l = b.find(" L3 Q");
+        std::optional<double> sensor = ParseNumber(std::string_view(b).substr(5, l - 5));
+        std::optional<double> timeout = ParseNumber(std::string_view(b).substr(l + 5));
+        if (!sensor || !timeout || *sensor != std::floor(*sensor) || *sensor < 0 || *sensor >= cell::kLinuxCncMaxDio ||
+            !(*timeout > 0)) {
+          Fail(line, "o<pick_place>'s wait for the vacuum sensor is not smtcal's");
+        }
+        wiring_.vacuum_sensor = static_cast<int>(*sensor);
+        wiring_.vacuum_timeout_s = *timeout;
+      } else if (b.starts_with("G0 X") && b.ends_with("#5") && b.size() > 3) {  // the move, its axis, its approach
+        const char axis = b[b.size() - 3];
+        if (axis != 'A' && axis != 'B' && axis != 'C') Fail(line, "o<pick_place>'s move is not smtcal's");
+        Axis(line, axis);
+        if (b.starts_with("G0 X[#2 - ")) {
+          const std::map<char, GNode> words = Words(line);
+          const GNode& x = words.at('X');
+          const GNode* y = words.count('Y') ? &words.at('Y') : nullptr;
+          if (!IsBinary(x, "-") || y == nullptr || !IsBinary(*y, "-") || x.operands[1].kind != GNode::Kind::kNumber ||
+              y->operands[1].kind != GNode::Kind::kNumber) {
+            Fail(line, "o<pick_place>'s final approach is not smtcal's");
+          }
+          Approach(line, Eigen::Vector2d(*ParseNumber(x.operands[1].text), *ParseNumber(y->operands[1].text)));
+        } else {
+          Approach(line, std::nullopt);
+        }
+      } else if (line.comment_only && line.comment.starts_with("abort,smtcal: Pick at ")) {
+        const std::string& c = line.comment;
+        const std::size_t end = c.find(":%d#9");
+        if (end == std::string::npos) Fail(line, "o<pick_place>'s abort is not smtcal's");
+        where = c.substr(22, end - 22);
+      }
+      // Its end, or as far as the longest the emitter writes: the comparison
+      // names the first line that differs.
+      if (b.starts_with("o<pick_place> endsub") || ++read > kMaxSubroutineLines) break;
+    }
+    // What it names is compared whole below: a line it could not be read
+    // from is the first that differs from the emitter's.
+    cell::Cell wired;
+    wired.linuxcnc.emplace();
+    wired.linuxcnc->rotation_axis = wiring_.axis.value_or('C');
+    wired.linuxcnc->vacuum_sensor_input = wiring_.vacuum_sensor.value_or(0);
+    wired.linuxcnc->vacuum_timeout_s = wiring_.vacuum_timeout_s.value_or(1);
+    wired.robot.final_approach_mm = wiring_.approach;
+    if (std::optional<ReadError> differs = FirstDifferenceIn(first.number, text,
+                                                              LinuxCncPickPlaceSubroutine(wired, where))) {
+      throw Failure{*differs};
+    }
+    pick_place_sub_ = true;
+  }
+
+  // The first line of `text` (the .ngc's lines from `first` on) that is not `expected`'s.
+  static std::optional<ReadError> FirstDifferenceIn(std::uint32_t first, std::string_view text, std::string_view expected) {
+    const std::vector<std::string_view> have = LinesOf(text), want = LinesOf(expected);
+    for (std::size_t i = 0; i < std::max(have.size(), want.size()); ++i) {
+      const std::uint32_t line = first + static_cast<std::uint32_t>(std::min(i, have.size() - 1));
+      if (i >= have.size()) return ReadError{line, fmt::format("it ends where smtcal writes '{}'", Shown(want[i]))};
+      if (i >= want.size()) return ReadError{line, "a line after the end of what smtcal writes"};
+      if (have[i] != want[i]) return ReadError{line, fmt::format("smtcal writes '{}' here", Shown(want[i]))};
+    }
+    return std::nullopt;
+  }
+
+  // Every move names the same rotation axis.
+  void Axis(const NgcLine& line, char axis) {
+    if (wiring_.axis && *wiring_.axis != axis) {
+      Fail(line, fmt::format("a move on the {} axis where the program turns u on {}", axis, *wiring_.axis));
+    }
+    wiring_.axis = axis;
+  }
+  // Every Jump (and o<pick_place>) makes the same final approach, or none.
+  void Approach(const NgcLine& line, const std::optional<Eigen::Vector2d>& approach) {
+    if (wiring_.approach_seen && wiring_.approach != approach) {
+      Fail(line, "a final approach other than the program's other moves make");
+    }
+    wiring_.approach_seen = true;
+    wiring_.approach = approach;
   }
 
   std::string TypeName(const std::string& name) const {
@@ -735,10 +1063,16 @@ class Decompiler {
     Emit("Fend", Next().number);
   }
 
-  // Statements until a line `stop` accepts (not consumed).
+  // Statements until a line `stop` accepts (not consumed). A block inside
+  // kMaxNesting others is refused at its first line: the .place parser
+  // would refuse it, and the recursion stays shallow.
   template <typename Stop>
   void Body(const Stop& stop) {
+    if (++depth_ > kMaxNesting) {
+      Fail(lines_[at_ - 1], fmt::format("blocks nested more than {} deep", kMaxNesting));
+    }
     while (!stop(Peek())) Statement();
+    --depth_;
   }
 
   // The temporaries and switch reads that prepare one statement.
@@ -830,11 +1164,16 @@ class Decompiler {
 
   // (Cycle F src:L) ... (EndCycle F src:L)
   void Cycle(const NgcLine& line) {
+    // The emitter writes a Cycle's blocks between these two comments; a
+    // Cycle inside a Cycle is no program smtcal compiles.
+    if (in_cycle_) Fail(line, "a Cycle inside a Cycle");
     const std::string name = line.comment.substr(6, line.comment.find(' ', 6) - 6);
     Emit("Cycle " + name, line.number);
     ++indent_;
+    in_cycle_ = true;
     const std::string end = "EndCycle " + name + " ";
     Body([&](const NgcLine& l) { return l.comment_only && l.comment.starts_with(end); });
+    in_cycle_ = false;
     --indent_;
     Emit("EndCycle", Next().number);
   }
@@ -1100,8 +1439,9 @@ class Decompiler {
   void PickPlace(const NgcLine& line, const Prepared& prepared, std::uint32_t at) {
     std::vector<GNode> arguments = CallArguments(line, std::string_view(line.block).substr(19));
     if (arguments.size() != 9) Fail(line, "o<pick_place> with other than nine arguments");
+    const int command = CommandArgument(line, arguments[0]);
     const std::string target = Target(line, {arguments[1], arguments[2], arguments[3], arguments[4]}, prepared, at);
-    CheckKind(line, arguments[0], target);
+    if (!IsNumber(arguments[7], "1") && !IsNumber(arguments[7], "0")) Fail(line, "o<pick_place> neither a Pick nor a Place");
     std::string text = fmt::format("{} {}", IsNumber(arguments[7], "1") ? "Pick" : "Place", target);
     const std::string vacuum = Decompile(line, arguments[6]).text;
     if (!vacuum_) {
@@ -1110,7 +1450,10 @@ class Decompiler {
     }
     if (vacuum != *vacuum_) text += " Vacuum " + vacuum;
     text += LimZ(line, arguments[5]);
-    Emit(text, at);
+    // The source line the abort names: the line the emitter wrote the call from.
+    if (arguments[8].kind != GNode::Kind::kNumber) Fail(line, "o<pick_place> without its source line");
+    if (pick_place_used_ == 0) pick_place_used_ = line.number;
+    Emit(text, at, command);
   }
 
   // " LimZ z", or "" for the cell's safe z (what a Pick, Place or Jump without one rises to).
@@ -1119,20 +1462,49 @@ class Decompiler {
     return " LimZ " + Decompile(line, z).text;
   }
 
-  // The fixture index written beside a position is the frame the position is in.
-  void CheckKind(const NgcLine& line, const GNode& k, const std::string& target) {
+  // The first argument of o<pick_place> and o<smtcal_correct>: how the
+  // runtime commands the position (linuxcnc_layout.h): a fixture of the
+  // data, kCommandBase or kCommandAsWritten. Held against the traced
+  // program by CheckLinuxCncCommands.
+  int CommandArgument(const NgcLine& line, const GNode& k) const {
     std::optional<double> index = k.kind == GNode::Kind::kNumber ? ParseNumber(k.text) : std::nullopt;
-    if (!index || *index < -2 || *index != std::floor(*index)) Fail(line, "a correction kind that is not a number");
-    (void)target;
+    if (!index || *index < L::kCommandAsWritten || *index != std::floor(*index) ||
+        *index >= static_cast<double>(cell_.fixtures.size())) {
+      Fail(line, "a correction argument that is neither a fixture of the data nor -1 or -2");
+    }
+    return static_cast<int>(*index);
   }
 
-  // [o<smtcal_correct> call [k] [x] [y]] then G0 Z / G0 X Y A / G0 Z (Jump), G0 X Y Z A (Go), G1 X Y Z A F (Move).
+  // The letters of a move: exactly `letters` (G and the axes), the rotation
+  // on the program's axis.
+  void Letters(const NgcLine& line, const std::map<char, GNode>& words, std::string_view letters) {
+    std::string have;
+    for (const auto& [letter, value] : words) {
+      if (letter == 'A' || letter == 'B' || letter == 'C') {
+        Axis(line, letter);
+        have += 'R';
+      } else {
+        have += letter;
+      }
+    }
+    std::string want(letters);
+    std::sort(want.begin(), want.end());
+    std::sort(have.begin(), have.end());
+    if (have != want) Fail(line, "a move with other words than smtcal writes");
+  }
+
+  // [o<smtcal_correct> call [k] [x] [y]] then G0 Z / G0 X Y A / G0 Z (Jump;
+  // with a final approach G0 Z / G0 X[x - a] Y[y - b] A / G0 X Y / G0 Z),
+  // G0 X Y Z A (Go), G1 X Y Z A F (Move).
   void Motion(const NgcLine& first, const Prepared& prepared, std::uint32_t at) {
     const NgcLine* line = &first;
     std::optional<std::array<GNode, 2>> corrected;
+    int command = L::kCommandAsWritten;
     if (first.block.starts_with("o<smtcal_correct> call ")) {
       std::vector<GNode> arguments = CallArguments(first, std::string_view(first.block).substr(23));
       if (arguments.size() != 3) Fail(first, "o<smtcal_correct> with other than three arguments");
+      command = CommandArgument(first, arguments[0]);
+      if (command == L::kCommandAsWritten) Fail(first, "o<smtcal_correct> told to command a position as given");
       corrected = std::array<GNode, 2>{arguments[1], arguments[2]};
       line = &Next();
     }
@@ -1144,29 +1516,61 @@ class Decompiler {
       limz = LimZ(*line, words.at('Z'));
       const NgcLine& across = Next();
       words = Words(across);
+      if (!across.block.starts_with("G0 ")) Fail(across, "a Jump whose move across is not G0");
+      Letters(across, words, "GXYR");
+      if (IsBinary(words.at('X'), "-") || IsBinary(words.at('Y'), "-")) {  // the final approach, then onto the target
+        const GNode& x = words.at('X');
+        const GNode& y = words.at('Y');
+        const NgcLine& onto = Next();
+        std::map<char, GNode> last = Words(onto);
+        if (!onto.block.starts_with("G0 ")) Fail(onto, "a Jump whose final approach is not G0");
+        Letters(onto, last, "GXY");
+        if (!IsBinary(x, "-") || !IsBinary(y, "-") || x.operands[1].kind != GNode::Kind::kNumber ||
+            y.operands[1].kind != GNode::Kind::kNumber || !Same(x.operands[0], last.at('X')) ||
+            !Same(y.operands[0], last.at('Y'))) {
+          Fail(across, "a Jump's final approach that is not smtcal's");
+        }
+        Approach(across, Eigen::Vector2d(*ParseNumber(x.operands[1].text), *ParseNumber(y.operands[1].text)));
+        words['X'] = last.at('X');
+        words['Y'] = last.at('Y');
+      } else {
+        Approach(across, std::nullopt);
+      }
       const NgcLine& down = Next();
       std::map<char, GNode> z = Words(down);
       if (!down.block.starts_with("G0 Z") || z.size() != 2) Fail(down, "a Jump without its descent");
       words['Z'] = z.at('Z');
+    } else if (line->block.starts_with("G1 ")) {
+      keyword = "Move";
+      Letters(*line, words, "GXYZRF");
+      std::optional<double> feed = words.at('F').kind == GNode::Kind::kNumber ? ParseNumber(words.at('F').text) : std::nullopt;
+      if (!feed || !(*feed > 0) || (wiring_.move_feed && *wiring_.move_feed != *feed)) {
+        Fail(*line, "a Move at another feed than the program's others (the robot's xy_speed_mm_s)");
+      }
+      wiring_.move_feed = *feed;
     } else {
-      keyword = line->block.starts_with("G1 ") ? "Move" : "Go";
+      keyword = "Go";
+      Letters(*line, words, "GXYZR");
     }
     const char rotation = words.count('A') ? 'A' : words.count('B') ? 'B' : 'C';
-    if (!words.count('X') || !words.count('Y') || !words.count('Z') || !words.count(rotation)) {
-      Fail(*line, "a move without X, Y, Z and its rotation");
-    }
     std::array<GNode, 4> xyzu = {words.at('X'), words.at('Y'), words.at('Z'), words.at(rotation)};
     if (corrected) {
       if (!IsParam(xyzu[0], "_smtcal_x") || !IsParam(xyzu[1], "_smtcal_y")) Fail(*line, "a corrected move without the correction");
       xyzu[0] = (*corrected)[0];
       xyzu[1] = (*corrected)[1];
-      // A fixture's rotation is added to u: [u + #<_smtcal_angle>].
-      if (IsBinary(xyzu[3], "+") && IsParam(xyzu[3].operands[1], "_smtcal_angle")) {
-        GNode u = xyzu[3].operands[0];
-        xyzu[3] = std::move(u);
-      }
     }
-    Emit(fmt::format("{} {}{}", keyword, Target(*line, xyzu, prepared, at), limz), at);
+    // A fixture's rotation is added to u, [u + #<_smtcal_angle>], exactly
+    // when the runtime corrects the position through a fixture.
+    const bool turned = IsBinary(xyzu[3], "+") && IsParam(xyzu[3].operands[1], "_smtcal_angle");
+    if (turned != (command >= 0)) {
+      Fail(*line, command >= 0 ? "a move through a fixture whose u does not turn with the board"
+                               : "a move whose u turns with a board it is not corrected through");
+    }
+    if (turned) {
+      GNode u = xyzu[3].operands[0];
+      xyzu[3] = std::move(u);
+    }
+    Emit(fmt::format("{} {}{}", keyword, Target(*line, xyzu, prepared, at), limz), at, command);
   }
 
   // The words of a G0/G1 block: letter -> value.
@@ -1194,7 +1598,9 @@ class Decompiler {
   // ---------------------------------------------------------------- expressions
 
   PExpr Expression(const NgcLine& line, std::string_view text) {
-    std::optional<GNode> node = ParseGExpr(text);
+    bool too_deep = false;
+    std::optional<GNode> node = ParseGExpr(text, &too_deep);
+    if (too_deep) Fail(line, fmt::format("brackets nested more than {} deep", kMaxNesting));
     if (!node) Fail(line, "an expression smtcal does not write");
     return Decompile(line, *node);
   }
@@ -1282,6 +1688,14 @@ class Decompiler {
   std::vector<std::uint32_t> pallet_lines_;
   std::optional<std::string> vacuum_;
   std::uint32_t vacuum_line_ = 0;
+  std::vector<int> commands_;     // per line of out_: how its motion is commanded
+  int depth_ = 0;                 // blocks open
+  bool in_cycle_ = false;
+  Wiring wiring_;
+  bool pick_place_sub_ = false;         // o<pick_place> is defined
+  std::uint32_t pick_place_used_ = 0;   // the first line that calls it, or 0
+  long runtime_id_ = -1;
+  std::uint32_t runtime_id_line_ = 0;
 };
 
 std::string ProgramNameOf(const std::string& main_path) {
@@ -1298,6 +1712,50 @@ bool LooksLikeLinuxCncOutput(const std::string& path) {
   std::error_code error;
   return fs::is_directory(path, error) || fs::path(path).extension() == ".ngc";
 }
+
+
+namespace {
+
+// The files the emitter writes into the runtime folder for a cell (besides
+// the runtime's own, LinuxCncRuntimeFiles).
+constexpr std::string_view kDataFile = "smtcal_data.ngc";
+constexpr std::string_view kScanAbortFile = "smtcal_scan_abort.ngc";
+constexpr std::string_view kRecordFile = "smtcal_record.ngc";
+constexpr std::string_view kRecordOpenFile = "smtcal_record_open.ngc";
+
+// Every file the runtime folder must hold.
+std::vector<std::string> RuntimeFolderFiles() {
+  std::vector<std::string> names = {std::string(kDataFile), std::string(kScanAbortFile), std::string(kRecordFile),
+                                    std::string(kRecordOpenFile)};
+  for (const EmbeddedFile& file : LinuxCncRuntimeFiles()) names.push_back(file.name);
+  return names;
+}
+
+// A text without the line that starts with `prefix` (the runtime id's).
+std::string WithoutLine(std::string_view text, std::string_view prefix) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find('\n', at);
+    end = end == std::string_view::npos ? text.size() : end + 1;
+    const std::string_view line = text.substr(at, end - at);
+    if (!line.starts_with(prefix)) out += line;
+    at = end;
+  }
+  return out;
+}
+
+// How a position is commanded, for messages.
+std::string CommandText(int command, const cell::Cell& cell) {
+  if (command == linuxcnc_layout::kCommandAsWritten) return "as given";
+  if (command == linuxcnc_layout::kCommandBase) return "as a base position through the error tables";
+  if (command >= 0 && static_cast<std::size_t>(command) < cell.fixtures.size()) {
+    return fmt::format("through fixture {}'s pose", cell.fixtures[static_cast<std::size_t>(command)].name);
+  }
+  return fmt::format("with {}", command);
+}
+
+}  // namespace
 
 Result<std::optional<LinuxCncOutputRead>> ReadLinuxCncOutput(const std::string& path, SourceManager& sources,
                                                              Diagnostics& diags) {
@@ -1318,35 +1776,166 @@ Result<std::optional<LinuxCncOutputRead>> ReadLinuxCncOutput(const std::string& 
     main = path;
     dir = main.parent_path();
   }
-  const fs::path data = dir / "subroutines" / "smtcal_data.ngc";
-  LinuxCncOutputRead read;
-  read.main_path = main.generic_string();
-  read.data_path = data.generic_string();
-  Result<std::uint32_t> main_file = sources.Load(read.main_path);
+  LinuxCncFolderFiles folder;
+  Result<std::uint32_t> main_file = sources.Load(main.generic_string());
   if (!main_file) return main_file.error();
-  Result<std::uint32_t> data_file = sources.Load(read.data_path);
-  if (!data_file) {
-    return Error{fmt::format("{} (a LinuxCNC output has its data in subroutines/smtcal_data.ngc)", data_file.error().message)};
+  folder.main = main_file.value();
+  folder.subroutines_dir = (dir / "subroutines").generic_string();
+  for (const std::string& name : RuntimeFolderFiles()) {
+    Result<std::uint32_t> file = sources.Load((dir / "subroutines" / name).generic_string());
+    if (!file) {
+      return Error{fmt::format("{} (a LinuxCNC output holds its runtime in subroutines/, every file smtcal writes "
+                               "there: compile the program again)",
+                               file.error().message)};
+    }
+    folder.subroutines.emplace_back(name, file.value());
   }
+  return ReadLinuxCncFolder(folder, sources, diags);
+}
+
+Result<std::optional<LinuxCncOutputRead>> ReadLinuxCncFolder(const LinuxCncFolderFiles& folder, SourceManager& sources,
+                                                             Diagnostics& diags) {
+  std::map<std::string, std::uint32_t, std::less<>> files(folder.subroutines.begin(), folder.subroutines.end());
+  for (const std::string& name : RuntimeFolderFiles()) {
+    if (!files.contains(name)) {
+      return Error{fmt::format("{}/{}: missing (a LinuxCNC output holds its runtime in subroutines/, every file smtcal "
+                               "writes there: compile the program again)",
+                               folder.subroutines_dir, name)};
+    }
+  }
+  auto file_of = [&](std::string_view name) -> const SourceFile& { return sources.File(files.find(name)->second); };
   auto report = [&](std::uint32_t file, const ReadError& failure) {
     diags.Report(DiagKind::LinuxCncOutputUnreadable, SourceRange(SourceLoc{file, failure.line, 1}), failure.what);
   };
-  DataReader data_reader(sources.File(data_file.value()));
-  if (std::optional<ReadError> failure = data_reader.Read(read.cell)) {
-    report(data_file.value(), *failure);
-    return std::optional<LinuxCncOutputRead>();
+  auto report_in = [&](std::string_view name, const ReadError& failure) { report(files.find(name)->second, failure); };
+  const std::optional<LinuxCncOutputRead> none;
+  LinuxCncOutputRead read;
+  read.main_file = folder.main;
+  read.main_path = sources.File(folder.main).name;
+  read.data_path = file_of(kDataFile).name;
+
+  // The data, decoded.
+  DataReader data(file_of(kDataFile));
+  if (std::optional<ReadError> failure = data.Read(read.cell)) {
+    report_in(kDataFile, *failure);
+    return none;
   }
   if (read.cell.path.empty()) read.cell.path = read.data_path;
-  Decompiler decompiler(sources.File(main_file.value()), read.cell, data_reader.safe_z(), ProgramNameOf(read.main_path));
-  std::string text;
-  if (std::optional<ReadError> failure = decompiler.Run(text, read.line_map)) {
-    report(main_file.value(), *failure);
-    return std::optional<LinuxCncOutputRead>();
+  // The runtime's own files: this smtcal's.
+  for (const EmbeddedFile& runtime : LinuxCncRuntimeFiles()) {
+    if (std::optional<ReadError> differs = FirstDifference(file_of(runtime.name), runtime.text, false)) {
+      differs->what = fmt::format("the runtime is not this smtcal's (runtime/linuxcnc/{}): {}", runtime.name, differs->what);
+      report_in(runtime.name, *differs);
+      return none;
+    }
   }
+  // The files written for the cell: what the emitter writes for the cell decoded.
+  read.cell.linuxcnc.emplace();
+  DecodeRecord(file_of(kRecordOpenFile), file_of(kRecordFile), *read.cell.linuxcnc);
+  if (std::optional<std::string> problem = LinuxCncRecordProblem(read.cell)) {
+    report_in(kRecordOpenFile, {1, *problem});
+    return none;
+  }
+  for (const auto& [name, text] : {std::pair{kScanAbortFile, EmitLinuxCncScanAbort(read.cell)},
+                                   std::pair{kRecordFile, EmitLinuxCncRecord(read.cell)},
+                                   std::pair{kRecordOpenFile, EmitLinuxCncRecordOpen(read.cell)}}) {
+    if (std::optional<ReadError> differs = FirstDifference(file_of(name), text, false)) {
+      report_in(name, *differs);
+      return none;
+    }
+  }
+  // The data as the emitter writes it for what was decoded: every line the
+  // runtime reads, up to the rounding of the geometry decoded.
+  if (std::optional<std::string> problem = LinuxCncDataProblem(read.cell)) {
+    report_in(kDataFile, {1, *problem});
+    return none;
+  }
+  const std::string_view id_prefix = L::kRuntimeIdParameter;
+  if (std::optional<ReadError> differs =
+          FirstDifference(file_of(kDataFile), EmitLinuxCncData(read.cell), /*rounding=*/true, id_prefix)) {
+    report_in(kDataFile, *differs);
+    return none;
+  }
+  // The runtime id: the one its files give, so no byte of them changed.
+  if (data.id_line() == 0) {
+    report_in(kDataFile, {1, fmt::format("no {} line", id_prefix)});
+    return none;
+  }
+  const long id = LinuxCncRuntimeIdOf(SMTCAL_VERSION, WithoutLine(file_of(kDataFile).text, id_prefix),
+                                      file_of(kScanAbortFile).text, file_of(kRecordFile).text,
+                                      file_of(kRecordOpenFile).text);
+  if (id != data.id()) {
+    report_in(kDataFile, {data.id_line(), fmt::format("it records runtime id {}, and the text of the runtime's files "
+                                                      "gives {}: a line of them was changed after smtcal wrote them",
+                                                      data.id(), id)});
+    return none;
+  }
+
+  // The main program.
+  Decompiler decompiler(sources.File(folder.main), read.cell, read.cell.robot.safe_limz_mm,
+                        ProgramNameOf(read.main_path));
+  std::string text;
+  if (std::optional<ReadError> failure = decompiler.Run(text, read.line_map, read.commands)) {
+    report(folder.main, *failure);
+    return none;
+  }
+  if (decompiler.runtime_id() != data.id()) {
+    report(folder.main, {decompiler.runtime_id_line(),
+                         fmt::format("it checks for runtime id {}, and its runtime's is {}", decompiler.runtime_id(), data.id())});
+    return none;
+  }
+  const auto& wiring = decompiler.wiring();
+  cell::LinuxCnc& linuxcnc = *read.cell.linuxcnc;
+  if (wiring.axis) linuxcnc.rotation_axis = *wiring.axis;
+  if (wiring.vacuum_sensor) linuxcnc.vacuum_sensor_input = *wiring.vacuum_sensor;
+  if (wiring.vacuum_timeout_s) linuxcnc.vacuum_timeout_s = *wiring.vacuum_timeout_s;
+  read.cell.robot.final_approach_mm = wiring.approach;
+  if (wiring.move_feed) read.cell.robot.xy_speed_mm_s = *wiring.move_feed / 60;
   // The .place program it lowers; the caller parses and checks it.
-  read.main_file = main_file.value();
   read.place_file = sources.Add(read.main_path, std::move(text));
   return std::optional<LinuxCncOutputRead>(std::move(read));
+}
+
+void CheckLinuxCncCommands(const ir::Program& program, const MachineTargets& targets, const LinuxCncOutputRead& read,
+                           Diagnostics& diags) {
+  const sema::SymbolTable& symbols = sema::SymbolsOf(program);
+  // The cell's index of the fixture a target hangs on, or kCommandBase.
+  auto fixture_of = [&](const ir::PointExpr& point) {
+    const sema::Symbol* fixture = nullptr;
+    if (const auto* named = std::get_if<ir::NamedPoint>(&point.base)) {
+      if (const sema::Symbol* symbol = symbols.Find(*named)) fixture = symbols.FixtureOfPoint(*symbol);
+    } else if (const auto* pallet = std::get_if<ir::PalletPoint>(&point.base)) {
+      if (std::optional<int> number = sema::FoldInteger(pallet->number.get())) fixture = symbols.FixtureOfPallet(*number);
+    }
+    const cell::Fixture* in_cell = fixture != nullptr ? read.cell.FindFixture(fixture->name) : nullptr;
+    return in_cell != nullptr ? static_cast<int>(in_cell - read.cell.fixtures.data()) : L::kCommandBase;
+  };
+  ir::ForEachStmt(program.items, [&](const ir::Stmt& stmt) {
+    const ir::PointExpr* target = nullptr;
+    if (const auto* motion = std::get_if<ir::Motion>(&stmt.node)) target = &motion->target;
+    if (const auto* pick = std::get_if<ir::PickPlace>(&stmt.node)) target = &pick->target;
+    if (target == nullptr || stmt.loc.file != read.place_file) return;
+    const std::uint32_t line = stmt.loc.line;
+    SMTCAL_CHECK(line >= 1 && line <= read.commands.size(), "every line of the text read back has its command");
+    const int given = read.commands[line - 1];
+    SMTCAL_CHECK(given != kNoLinuxCncCommand, "the reader wrote a motion only from a line that commands it");
+    // What the program's text makes of it: the traced positions' kind; a
+    // statement the compile-time run never reached is corrected on the
+    // controller, through its fixture when it has one (as the emitter does).
+    int expected = fixture_of(*target);
+    const std::span<const MachineTarget> positions = targets.Of(&stmt);
+    if (!positions.empty()) {
+      const MachineTarget& first = positions.front();
+      expected = first.kind == MachineTarget::Kind::kFixture   ? first.fixture
+                 : first.kind == MachineTarget::Kind::kRunTime ? L::kCommandBase
+                                                               : L::kCommandAsWritten;
+    }
+    if (given == expected) return;
+    diags.Report(DiagKind::LinuxCncOutputUnreadable,
+                 SourceRange(SourceLoc{read.main_file, read.line_map[line - 1], 1}),
+                 fmt::format("the runtime is told to command this position {}, and the program's text {}",
+                             CommandText(given, read.cell), CommandText(expected, read.cell)));
+  });
 }
 
 }  // namespace smtcal
