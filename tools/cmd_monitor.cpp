@@ -9,7 +9,7 @@
 #include "backend/reports/monitor_report.h"
 #include "base/field_text.h"
 #include "base/json_text.h"
-#include "calibration/cycle_monitor.h"
+#include "spc/cycle_monitor.h"
 #include "calibration/limits.h"
 #include "frontend/cell_toml.h"
 #include "frontend/record_log.h"

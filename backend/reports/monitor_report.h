@@ -1,6 +1,6 @@
 // Reports of `smtcal monitor` (docs/monitor.md): the text summary, the JSON
 // report and the SVG control charts of what a log of cycle records says
-// (calibration/cycle_monitor.h). Deterministic: the same logs give the same
+// (spc/cycle_monitor.h). Deterministic: the same logs give the same
 // bytes.
 #pragma once
 
@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calibration/cell.h"
-#include "calibration/cycle_monitor.h"
+#include "spc/cycle_monitor.h"
 
 namespace smtcal {
 

@@ -70,7 +70,7 @@ std::string_view ChartRuleDescription(ChartRule rule);  // "a point beyond 3 sig
 enum class Direction { kBoth, kUp, kDown };  // the drifts a CUSUM watches for
 
 struct ChartOptions {
-  std::size_t baseline = 30;  // the first values: centre line and sigma
+  std::size_t baseline = 30;  // RunChart without a reference: the first values set the centre line and sigma
   // The tabular CUSUM: reference value k and decision interval h in sigmas;
   // each standardized value is clipped to +-clip first (a robust CUSUM: one
   // wild value moves it by at most clip - k).
@@ -103,13 +103,53 @@ struct RuleRun {
   std::size_t first = 0, last = 0;
 };
 
-struct ChartResult {
-  std::size_t baseline = 0;  // values used for the centre and sigma
+// What a chart judges values against (Phase I's result, spc/baseline.h, or
+// a stored baseline): the centre line and sigma and the number of values
+// they were estimated from, which the guard widens the chart by.
+struct ChartReference {
+  long n = 0;
   double center = 0;
   double sigma_estimate = 0;  // max(moving range mean / d2 (1.128), the sample's), at least the resolution
+  double mr_mean = 0;         // the mean moving range
+};
+
+// The plain estimate from all of `values` (at least 2: checked).
+ChartReference EstimateReference(const std::vector<double>& values, double resolution);
+
+// The decision statistics of a chart, one standardized value at a time:
+// the two tabular CUSUMs and the EWMA with its limit (all in sigmas). The
+// one implementation of the verdict's arithmetic: RunChart, the pictures'
+// traces and the run-length simulations use it.
+class ChartStatistic {
+ public:
+  // k: the CUSUM's reference value; centre_uncertainty: what the EWMA's
+  // limit grows by (both in sigmas; ChartOptions::guard_estimates).
+  ChartStatistic(const ChartOptions& options, double k, double centre_uncertainty);
+  struct Step {
+    double clipped = 0;                  // the value the statistics took (clipped to +-clip)
+    double cusum_up = 0, cusum_down = 0;  // >= 0
+    double ewma = 0, ewma_limit = 0;      // the EWMA and its limit at this value (the limit's own sigma grows)
+    bool cusum_up_alarm = false, cusum_down_alarm = false, ewma_up_alarm = false, ewma_down_alarm = false;
+    bool alarm() const { return cusum_up_alarm || cusum_down_alarm || ewma_up_alarm || ewma_down_alarm; }
+  };
+  Step Add(double z);
+
+ private:
+  ChartOptions options_;
+  double k_, centre_uncertainty_;
+  bool up_, down_;
+  double c_up_ = 0, c_down_ = 0, ewma_ = 0, decay_ = 1;
+};
+
+struct ChartResult {
+  std::size_t baseline = 0;  // values of the reference (ChartReference::n)
+  double center = 0;
+  double sigma_estimate = 0;  // the reference's
   double sigma = 0;           // the chart's: the estimate, guarded (ChartOptions::guard_estimates)
   double cusum_k = 0;         // the CUSUM's reference value in sigmas, guarded
-  double mr_mean = 0;         // mean moving range of the baseline
+  double centre_uncertainty = 0;  // in sigmas: what guarding added to k and to the EWMA's limit
+  double mr_mean = 0;         // mean moving range of the reference
+  ChartOptions options;       // as run
   std::vector<RuleRun> runs;  // every run of every rule, in order of their first point
   // The first alarm of the CUSUM or the EWMA: where it crossed its limit,
   // the rule, the direction, and where the shift it signals most likely
@@ -122,8 +162,18 @@ struct ChartResult {
   std::size_t change_point = 0;
 };
 
-// A chart of individual values (at least 2 in the baseline: checked).
+// A chart of individual values against a reference.
+ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options);
+// ... against the plain estimate of the first options.baseline values (at
+// least 2: checked).
 ChartResult RunChart(const std::vector<double>& values, const ChartOptions& options);
+
+// What a picture or a spreadsheet draws of a chart: per value its
+// standardized value, the statistics (ChartStatistic) and the moving range.
+struct ChartTrace {
+  std::vector<double> cusum_up, cusum_down, ewma, ewma_limit, moving_range;
+};
+ChartTrace TraceChart(const std::vector<double>& values, const ChartResult& chart);
 
 // A least-squares line through (x, y) pairs: the slope with its standard
 // error and the line's value at the last x. At least 3 points with distinct
@@ -134,10 +184,5 @@ struct Trend {
   double end_x = 0;
 };
 Trend FitTrend(const std::vector<double>& x, const std::vector<double>& y);
-
-// A Bernoulli CUSUM of rare events (refusals): the log-likelihood ratio of
-// the rate p1 against p0 summed, reset at zero, alarming at h. The index
-// of the first alarm, or nullopt.
-std::optional<std::size_t> BernoulliCusum(const std::vector<bool>& events, double p0, double p1, double h);
 
 }  // namespace smtcal

@@ -22,7 +22,7 @@
 
 #include "calibration/cell.h"
 #include "calibration/cycle_record.h"
-#include "calibration/spc.h"
+#include "spc/control_chart.h"
 
 namespace smtcal {
 

@@ -1,5 +1,5 @@
-// Statistical process control (calibration/spc.h).
-#include "calibration/spc.h"
+// Statistical process control (spc/control_chart.h).
+#include "spc/control_chart.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "base/check.h"
+#include "calibration/capability.h"
 
 namespace smtcal {
 namespace {
@@ -161,22 +162,18 @@ ProcessFigures FiguresOf(const std::vector<double>& values, double confidence, L
   ProcessFigures f;
   f.n = static_cast<long>(values.size());
   if (values.empty()) return f;
-  double sum = 0;
-  for (double v : values) sum += v;
-  const double n = static_cast<double>(values.size());
-  const double mean = sum / n;
+  const MeanSigma sample = MeanAndSigma(values);  // calibration/capability.h: the one sigma
+  const double mean = sample.mean, s = sample.sigma;
   f.mean = {mean, mean, mean};
   if (values.size() < 2) return f;
-  double squares = 0;
-  for (double v : values) squares += (v - mean) * (v - mean);
-  const double s = std::sqrt(squares / (n - 1));
+  const double n = static_cast<double>(values.size());
   const double alpha = 1 - confidence;
   const double t = StudentTQuantile(1 - alpha / 2, n - 1);
   f.mean = {mean, mean - t * s / std::sqrt(n), mean + t * s / std::sqrt(n)};
   f.sigma = {s, s * std::sqrt((n - 1) / ChiSquareQuantile(1 - alpha / 2, n - 1)),
              s * std::sqrt((n - 1) / ChiSquareQuantile(alpha / 2, n - 1))};
   if (kind != LimitKind::kNone && s > 0) {
-    const double c = kind == LimitKind::kTwoSided ? (limit - std::abs(mean)) / (3 * s) : (limit - mean) / (3 * s);
+    const double c = kind == LimitKind::kTwoSided ? Cmk(limit, mean, s) : CmkUpper(limit, mean, s);
     const double half = NormalQuantile(1 - alpha / 2) * std::sqrt(1 / (9 * n) + c * c / (2 * (n - 1)));
     f.cmk = Interval{c, c - half, c + half};
   }
@@ -215,41 +212,93 @@ std::string_view ChartRuleDescription(ChartRule rule) {
   return "?";
 }
 
-ChartResult RunChart(const std::vector<double>& values, const ChartOptions& options) {
-  ChartResult chart;
-  chart.baseline = std::min(options.baseline, values.size());
-  SMTCAL_CHECK(chart.baseline >= 2, "a control chart needs a baseline of at least 2 values");
-  double sum = 0, ranges = 0;
-  for (std::size_t i = 0; i < chart.baseline; ++i) {
-    sum += values[i];
-    if (i > 0) ranges += std::abs(values[i] - values[i - 1]);
-  }
-  const double m = static_cast<double>(chart.baseline);
-  chart.center = sum / m;
-  chart.mr_mean = ranges / (m - 1);
-  double squares = 0;
-  for (std::size_t i = 0; i < chart.baseline; ++i) squares += (values[i] - chart.center) * (values[i] - chart.center);
+ChartReference EstimateReference(const std::vector<double>& values, double resolution) {
+  SMTCAL_CHECK(values.size() >= 2, "a chart's reference needs at least 2 values");
+  ChartReference reference;
+  reference.n = static_cast<long>(values.size());
+  double ranges = 0;
+  for (std::size_t i = 1; i < values.size(); ++i) ranges += std::abs(values[i] - values[i - 1]);
+  const MeanSigma sample = MeanAndSigma(values);
+  reference.center = sample.mean;
+  reference.mr_mean = ranges / static_cast<double>(values.size() - 1);
   // sigma: the larger of the moving range's (robust to a drift in the
   // baseline) and the sample's (not fooled by heavy tails), at least the
-  // resolution; guarded, its upper 95 % bound for the baseline's size.
-  chart.sigma_estimate = std::max({chart.mr_mean / kD2, std::sqrt(squares / (m - 1)), options.resolution});
+  // resolution.
+  reference.sigma_estimate = std::max({reference.mr_mean / kD2, sample.sigma, resolution});
+  return reference;
+}
+
+ChartStatistic::ChartStatistic(const ChartOptions& options, double k, double centre_uncertainty)
+    : options_(options),
+      k_(k),
+      centre_uncertainty_(centre_uncertainty),
+      up_(options.direction != Direction::kDown),
+      down_(options.direction != Direction::kUp) {}
+
+ChartStatistic::Step ChartStatistic::Add(double z) {
+  Step step;
+  step.clipped = std::clamp(z, -options_.cusum_clip, options_.cusum_clip);
+  c_up_ = up_ ? std::max(0.0, c_up_ + step.clipped - k_) : 0.0;
+  c_down_ = down_ ? std::max(0.0, c_down_ - step.clipped - k_) : 0.0;
+  const double lambda = options_.ewma_lambda;
+  ewma_ = lambda * step.clipped + (1 - lambda) * ewma_;
+  decay_ *= (1 - lambda) * (1 - lambda);
+  step.cusum_up = c_up_;
+  step.cusum_down = c_down_;
+  step.ewma = ewma_;
+  step.ewma_limit = options_.ewma_l * std::sqrt(lambda / (2 - lambda) * (1 - decay_)) + centre_uncertainty_;
+  step.cusum_up_alarm = c_up_ > options_.cusum_h;
+  step.cusum_down_alarm = c_down_ > options_.cusum_h;
+  step.ewma_up_alarm = up_ && ewma_ > step.ewma_limit;
+  step.ewma_down_alarm = down_ && ewma_ < -step.ewma_limit;
+  return step;
+}
+
+namespace {
+
+// The chart's sigma and k from its reference: guarded, sigma is its upper
+// 95 % bound for the reference's size and k grows by the centre's
+// uncertainty (the centre line is known to +-1.645 sigma / sqrt(n)).
+ChartResult Prepared(const ChartReference& reference, const ChartOptions& options) {
+  SMTCAL_CHECK(reference.n >= 2, "a chart's reference of at least 2 values");
+  ChartResult chart;
+  chart.options = options;
+  chart.baseline = static_cast<std::size_t>(reference.n);
+  chart.center = reference.center;
+  chart.sigma_estimate = reference.sigma_estimate;
+  chart.mr_mean = reference.mr_mean;
   chart.sigma = chart.sigma_estimate;
-  double k = options.cusum_k;
-  double centre_uncertainty = 0;
+  chart.cusum_k = options.cusum_k;
   if (options.guard_estimates) {
+    const double m = static_cast<double>(reference.n);
     chart.sigma *= std::sqrt((m - 1) / ChiSquareQuantile(0.05, m - 1));
-    centre_uncertainty = NormalQuantile(0.95) / std::sqrt(m);  // the centre line is known to +-1.645 sigma / sqrt(n)
-    k += centre_uncertainty;
+    chart.centre_uncertainty = NormalQuantile(0.95) / std::sqrt(m);
+    chart.cusum_k += chart.centre_uncertainty;
   }
-  chart.cusum_k = k;
+  return chart;
+}
+
+double Standardized(double value, const ChartResult& chart) {
+  const double deviation = value - chart.center;
+  if (chart.sigma > 0) return deviation / chart.sigma;
+  return deviation == 0 ? 0 : std::copysign(std::numeric_limits<double>::infinity(), deviation);
+}
+
+}  // namespace
+
+ChartResult RunChart(const std::vector<double>& values, const ChartOptions& options) {
+  const std::size_t baseline = std::min(options.baseline, values.size());
+  SMTCAL_CHECK(baseline >= 2, "a control chart needs a baseline of at least 2 values");
+  const std::vector<double> first(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(baseline));
+  return RunChart(values, EstimateReference(first, options.resolution), options);
+}
+
+ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options) {
+  ChartResult chart = Prepared(reference, options);
   const bool up = options.direction != Direction::kDown, down = options.direction != Direction::kUp;
   const std::size_t n = values.size();
   std::vector<double> z(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double deviation = values[i] - chart.center;
-    z[i] = chart.sigma > 0 ? deviation / chart.sigma
-                           : (deviation == 0 ? 0 : std::copysign(std::numeric_limits<double>::infinity(), deviation));
-  }
+  for (std::size_t i = 0; i < n; ++i) z[i] = Standardized(values[i], chart);
 
   // The rules at each point, then grouped into runs.
   std::vector<std::vector<bool>> holds(kChartRules, std::vector<bool>(n, false));
@@ -258,11 +307,9 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     for (std::size_t j = end + 1 - window; j <= end; ++j) count += sign * z[j] > level ? 1 : 0;
     return count;
   };
-  double c_up = 0, c_down = 0;
+  ChartStatistic statistic(options, chart.cusum_k, chart.centre_uncertainty);
   std::size_t last_zero_up = 0, last_zero_down = 0;
   bool zero_up_seen = false, zero_down_seen = false;
-  const double lambda = options.ewma_lambda;
-  double ewma = 0, decay = 1;  // decay: (1 - lambda)^2i
   std::optional<std::size_t> last_below, last_above;  // the EWMA's last value at or below / above the centre
   for (std::size_t i = 0; i < n; ++i) {
     auto set = [&](ChartRule rule) { holds[static_cast<std::size_t>(rule)][i] = true; };
@@ -292,42 +339,36 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
     if (i >= 1 && std::abs(values[i] - values[i - 1]) > kD4 * chart.mr_mean && chart.mr_mean > 0) {
       set(ChartRule::kMovingRange);
     }
-    const double clipped = std::clamp(z[i], -options.cusum_clip, options.cusum_clip);
-    c_up = up ? std::max(0.0, c_up + clipped - k) : 0.0;
-    c_down = down ? std::max(0.0, c_down - clipped - k) : 0.0;
-    if (c_up > options.cusum_h) set(ChartRule::kCusumUp);
-    if (c_down > options.cusum_h) set(ChartRule::kCusumDown);
-    if (!chart.alarm && (c_up > options.cusum_h || c_down > options.cusum_h)) {
+    const ChartStatistic::Step step = statistic.Add(z[i]);
+    if (step.cusum_up_alarm) set(ChartRule::kCusumUp);
+    if (step.cusum_down_alarm) set(ChartRule::kCusumDown);
+    if (!chart.alarm && (step.cusum_up_alarm || step.cusum_down_alarm)) {
       chart.alarm = i;
-      const bool upward = c_up > options.cusum_h;
+      const bool upward = step.cusum_up_alarm;
       chart.alarm_rule = upward ? ChartRule::kCusumUp : ChartRule::kCusumDown;
       chart.alarm_direction = upward ? Direction::kUp : Direction::kDown;
       const bool seen = upward ? zero_up_seen : zero_down_seen;
       chart.change_point = seen ? (upward ? last_zero_up : last_zero_down) + 1 : 0;
     }
-    ewma = lambda * clipped + (1 - lambda) * ewma;
-    decay *= (1 - lambda) * (1 - lambda);
-    const double limit = options.ewma_l * std::sqrt(lambda / (2 - lambda) * (1 - decay)) + centre_uncertainty;
-    const bool ewma_up = up && ewma > limit, ewma_down = down && ewma < -limit;
-    if (ewma_up) set(ChartRule::kEwmaUp);
-    if (ewma_down) set(ChartRule::kEwmaDown);
-    if (!chart.alarm && (ewma_up || ewma_down)) {
+    if (step.ewma_up_alarm) set(ChartRule::kEwmaUp);
+    if (step.ewma_down_alarm) set(ChartRule::kEwmaDown);
+    if (!chart.alarm && (step.ewma_up_alarm || step.ewma_down_alarm)) {
       chart.alarm = i;
-      chart.alarm_rule = ewma_up ? ChartRule::kEwmaUp : ChartRule::kEwmaDown;
-      chart.alarm_direction = ewma_up ? Direction::kUp : Direction::kDown;
+      chart.alarm_rule = step.ewma_up_alarm ? ChartRule::kEwmaUp : ChartRule::kEwmaDown;
+      chart.alarm_direction = step.ewma_up_alarm ? Direction::kUp : Direction::kDown;
       // Where the drift began: after the EWMA last stood on the centre
       // line's other side (for a slow ramp nearer the start than the
       // CUSUM's last zero, which its reference value k holds back).
-      const std::optional<std::size_t>& other_side = ewma_up ? last_below : last_above;
+      const std::optional<std::size_t>& other_side = step.ewma_up_alarm ? last_below : last_above;
       chart.change_point = other_side ? *other_side + 1 : 0;
     }
-    if (ewma <= 0) last_below = i;
-    if (ewma >= 0) last_above = i;
-    if (c_up == 0) {
+    if (step.ewma <= 0) last_below = i;
+    if (step.ewma >= 0) last_above = i;
+    if (step.cusum_up == 0) {
       last_zero_up = i;
       zero_up_seen = true;
     }
-    if (c_down == 0) {
+    if (step.cusum_down == 0) {
       last_zero_down = i;
       zero_down_seen = true;
     }
@@ -344,6 +385,20 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
   std::stable_sort(chart.runs.begin(), chart.runs.end(),
                    [](const RuleRun& a, const RuleRun& b) { return a.first < b.first; });
   return chart;
+}
+
+ChartTrace TraceChart(const std::vector<double>& values, const ChartResult& chart) {
+  ChartTrace trace;
+  ChartStatistic statistic(chart.options, chart.cusum_k, chart.centre_uncertainty);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const ChartStatistic::Step step = statistic.Add(Standardized(values[i], chart));
+    trace.cusum_up.push_back(step.cusum_up);
+    trace.cusum_down.push_back(step.cusum_down);
+    trace.ewma.push_back(step.ewma);
+    trace.ewma_limit.push_back(step.ewma_limit);
+    trace.moving_range.push_back(i == 0 ? 0.0 : std::abs(values[i] - values[i - 1]));
+  }
+  return trace;
 }
 
 Trend FitTrend(const std::vector<double>& x, const std::vector<double>& y) {
@@ -373,17 +428,6 @@ Trend FitTrend(const std::vector<double>& x, const std::vector<double>& y) {
   trend.end_x = x.back();
   trend.at_end = my + trend.slope * (x.back() - mx);
   return trend;
-}
-
-std::optional<std::size_t> BernoulliCusum(const std::vector<bool>& events, double p0, double p1, double h) {
-  SMTCAL_CHECK(p0 > 0 && p1 > p0 && p1 < 1 && h > 0, "rates 0 < p0 < p1 < 1 and h > 0");
-  const double hit = std::log(p1 / p0), miss = std::log((1 - p1) / (1 - p0));
-  double s = 0;
-  for (std::size_t i = 0; i < events.size(); ++i) {
-    s = std::max(0.0, s + (events[i] ? hit : miss));
-    if (s >= h) return i;
-  }
-  return std::nullopt;
 }
 
 }  // namespace smtcal

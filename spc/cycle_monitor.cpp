@@ -1,5 +1,5 @@
-// What a log of cycle records says about the cell (calibration/cycle_monitor.h).
-#include "calibration/cycle_monitor.h"
+// What a log of cycle records says about the cell (spc/cycle_monitor.h).
+#include "spc/cycle_monitor.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +12,8 @@
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/placement_budget.h"
+#include "calibration/sample_statistics.h"
+#include "spc/bernoulli_cusum.h"
 
 namespace smtcal {
 namespace {
@@ -236,11 +238,6 @@ std::optional<double> ScansToCircle(const Eigen::Vector2d& p, const Eigen::Vecto
   return (-b + std::sqrt(b * b - 4 * a * c)) / (2 * a);
 }
 
-std::optional<double> Median(std::vector<double> values) {
-  if (values.empty()) return std::nullopt;
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
 
 class FixtureAnalysis {
  public:
@@ -273,7 +270,7 @@ class FixtureAnalysis {
       ++out.accepted;
       Measure(record, *fix, scan, out);
     }
-    out.seconds_per_scan = Median(gaps);
+    if (!gaps.empty()) out.seconds_per_scan = Median(gaps);
     Refusals(records, out);
     out.far_corner = FindFarCorner(cell_, fixture_);
     out.trip_centre = TripCentre(fixture_);
@@ -377,12 +374,8 @@ class FixtureAnalysis {
       // refusal and one acceptance (Laplace), so a clean baseline does not
       // make the first refusal an alarm.
       refusal.p0 = (static_cast<double>(refusal.baseline_count) + 1) / (static_cast<double>(baseline) + 2);
-      const double p1 = std::min(0.9, 4 * refusal.p0);
-      if (p1 > refusal.p0) {
-        if (std::optional<std::size_t> alarm = BernoulliCusum(events, refusal.p0, p1, options_.refusal_h)) {
-          refusal.alarm_scan = static_cast<long>(*alarm + 1);
-        }
-      }
+      const BernoulliCusumRun run = RunBernoulliCusum(events, DesignBernoulliCusum(std::max(refusal.p0, kRefusalRateFloor)));
+      if (run.alarm) refusal.alarm_scan = static_cast<long>(*run.alarm + 1);
       out.refusals.push_back(refusal);
     }
   }

@@ -1,4 +1,4 @@
-// Statistical process control (calibration/spc.h): the quantiles against
+// Statistical process control (spc/control_chart.h): the quantiles against
 // published tables, the confidence intervals' coverage on random normal
 // samples, each chart rule on a sequence made to fire it, the CUSUM's false
 // alarms and detection delay.
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "calibration/spc.h"
+#include "spc/control_chart.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
 namespace smtcal {
@@ -197,17 +197,6 @@ TEST(Spc, TrendIsTheLeastSquaresLine) {
   const Trend noisy = FitTrend({0, 1, 2, 3, 4}, {0, 1.1, 1.9, 3.2, 3.8});
   EXPECT_NEAR(noisy.slope, 0.97, 1e-12);
   EXPECT_GT(noisy.slope_se, 0);
-}
-
-TEST(Spc, BernoulliCusumAlarmsOnABurstOfEvents) {
-  std::vector<bool> events(500, false);
-  events[100] = true;  // one refusal in 500: no alarm at p0 = 1 %
-  EXPECT_FALSE(BernoulliCusum(events, 0.01, 0.04, std::log(20000.0)));
-  for (std::size_t i = 300; i < 330; i += 3) events[i] = true;  // 10 in 30
-  const std::optional<std::size_t> alarm = BernoulliCusum(events, 0.01, 0.04, std::log(20000.0));
-  ASSERT_TRUE(alarm);
-  EXPECT_GE(*alarm, 300u);
-  EXPECT_LE(*alarm, 330u);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// What a log of cycle records says (calibration/cycle_monitor.h), on scans
+// What a log of cycle records says (spc/cycle_monitor.h), on scans
 // simulated here: in control, nothing; a board that walks, a robot whose
 // scale changes, a sensor whose threshold moves — each found by its own
 // chart and named, after it began; a record that another cell's tables
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "calibration/cycle_monitor.h"
+#include "spc/cycle_monitor.h"
 #include "calibration/fixture_estimation.h"
 #include "tests/unit/calibration/fixture_test_cell.h"
 
