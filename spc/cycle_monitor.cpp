@@ -6,9 +6,11 @@
 #include <limits>
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 
 #include "base/check.h"
 #include "base/field_text.h"
+#include "base/number_range.h"
 #include "calibration/fixture_estimation.h"
 #include "calibration/fixture_geometry.h"
 #include "calibration/placement_budget.h"
@@ -239,17 +241,84 @@ std::optional<double> ScansToCircle(const Eigen::Vector2d& p, const Eigen::Vecto
 }
 
 
+// The monitor's checks of records against the cell: positions the robot
+// cannot reach are no scan's (docs/monitor.md, "Values").
+struct Travel {
+  double x_lo, x_hi, y_lo, y_hi;
+  bool Holds(const Eigen::Vector2d& p) const { return p.x() >= x_lo && p.x() <= x_hi && p.y() >= y_lo && p.y() <= y_hi; }
+  std::string Text() const {
+    return fmt::format("x {}..{}, y {}..{} mm", NumberText(x_lo), NumberText(x_hi), NumberText(y_lo), NumberText(y_hi));
+  }
+};
+
+// The robot's travel widened by the fixture's size: its markers are within
+// reach, and S1..S3 are corners of the board's frame near them.
+Travel TravelOf(const cell::Cell& cell, const cell::Fixture& fixture) {
+  const double widen = std::max(fixture.l1_mm, fixture.l2_mm);
+  const cell::Interval& x = cell.robot.limits[0];
+  const cell::Interval& y = cell.robot.limits[1];
+  return {x.lo - widen, x.hi + widen, y.lo - widen, y.hi + widen};
+}
+
+bool RecordInTravel(const MonitoredCycle& cycle, const Travel& travel, std::string_view cell_name, Diagnostics& diags) {
+  auto outside = [&](std::string what, const Eigen::Vector2d& p) {
+    diags.Report(DiagKind::RecordAbsurdValue, cycle.where, what, cycle.record.cycle, cycle.fixture,
+                 fmt::format("({}, {}) mm", NumberText(p.x()), NumberText(p.y())),
+                 fmt::format("outside cell '{}''s robot travel widened by the fixture's size ({}): the robot cannot "
+                             "have been there, so the record is not a scan's",
+                             cell_name, travel.Text()));
+    return false;
+  };
+  for (std::size_t k = 0; k < cycle.record.trips.size(); ++k) {
+    if (cycle.record.trips[k] && !travel.Holds(*cycle.record.trips[k])) {
+      return outside(fmt::format("trip T{}", k + 1), *cycle.record.trips[k]);
+    }
+  }
+  if (cycle.record.estimate) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (!travel.Holds((*cycle.record.estimate)[k])) return outside(fmt::format("S{}", k + 1), (*cycle.record.estimate)[k]);
+    }
+  }
+  return true;
+}
+
+std::string Where(const Diagnostics& diags, const SourceRange& where) {
+  if (where.begin.file == 0) return "-";
+  return fmt::format("{}:{}", diags.sources().File(where.begin.file).name, where.begin.line);
+}
+
+std::string ScanList(const std::vector<long>& scans) {
+  std::string text;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    if (i == 8) {
+      text += fmt::format(" and {} more", scans.size() - i);
+      break;
+    }
+    text += (i == 0 ? "" : ", ") + std::to_string(scans[i]);
+  }
+  return text;
+}
+
 class FixtureAnalysis {
  public:
-  FixtureAnalysis(const cell::Cell& cell, const cell::Fixture& fixture, const MonitorOptions& options)
-      : cell_(cell), fixture_(fixture), options_(options), diagnostics_(fixture), nominal_(NominalFix(fixture)) {}
+  FixtureAnalysis(const cell::Cell& cell, const cell::Fixture& fixture, const MonitorOptions& options,
+                  const std::vector<MonitoredCycle>& cycles, Diagnostics& diags)
+      : cell_(cell),
+        fixture_(fixture),
+        options_(options),
+        cycles_(cycles),
+        diags_(diags),
+        diagnostics_(fixture),
+        nominal_(NominalFix(fixture)) {}
 
-  FixtureMonitor Run(const std::vector<const CycleRecord*>& records) {
+  FixtureMonitor Run(const std::vector<std::size_t>& indices, const FixtureBaseline* stored) {
     FixtureMonitor out;
     out.name = fixture_.name;
     out.fixture = &fixture_;
-    out.scans = static_cast<long>(records.size());
+    out.records = indices;
+    out.scans = static_cast<long>(indices.size());
     out.threshold_identifiable = diagnostics_.threshold();
+    out.origin_mm = fixture_.origin_mm;
     for (std::size_t q = 0; q < kQuantities; ++q) {
       out.series[q].quantity = static_cast<Quantity>(q);
       out.series[q].gates = kInfo[q].gates;
@@ -257,13 +326,17 @@ class FixtureAnalysis {
     Teach(out);
     std::vector<double> gaps;
     std::optional<Eigen::Affine3d> previous;
-    for (std::size_t i = 0; i < records.size(); ++i) {
-      const CycleRecord& record = *records[i];
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      const MonitoredCycle& cycle = cycles_[indices[i]];
+      const CycleRecord& record = cycle.record;
       const double scan = static_cast<double>(i + 1);
-      if (i > 0 && record.time_s && records[i - 1]->time_s && *record.time_s > *records[i - 1]->time_s) {
-        gaps.push_back(*record.time_s - *records[i - 1]->time_s);
+      const bool restart = cycle.restart || record.cycle == 1;
+      if (restart && i > 0) out.restarts.push_back(static_cast<long>(i + 1));
+      if (i > 0 && !restart && cycle.run == cycles_[indices[i - 1]].run && record.time_s &&
+          cycles_[indices[i - 1]].record.time_s && *record.time_s > *cycles_[indices[i - 1]].record.time_s) {
+        gaps.push_back(*record.time_s - *cycles_[indices[i - 1]].record.time_s);
       }
-      if (record.cycle == 1) previous.reset();  // a new run: the runtime has no previous pose
+      if (restart) previous.reset();  // a new run: the runtime has no previous pose
       const std::optional<Eigen::Affine3d> fix = Recompute(record, previous, static_cast<long>(i + 1), out);
       if (!record.accepted() || !record.estimate) continue;
       previous = fix;
@@ -271,14 +344,170 @@ class FixtureAnalysis {
       Measure(record, *fix, scan, out);
     }
     if (!gaps.empty()) out.seconds_per_scan = Median(gaps);
-    Refusals(records, out);
     out.far_corner = FindFarCorner(cell_, fixture_);
     out.trip_centre = TripCentre(fixture_);
+    for (std::size_t q = 0; q < kQuantities; ++q) {
+      SeriesResult& series = out.series[q];
+      if (series.values.empty()) continue;
+      const auto [limit_kind, limit] = LimitOf(static_cast<Quantity>(q));
+      out.process[q] = FiguresOf(series.values, options_.confidence, limit_kind, limit);
+    }
+    const bool based = stored ? Stored(*stored, out) : Baseline(out);
+    if (!based) return out;
+    out.charted = true;
+    Refusals(out);
     Chart(out);
+    Findings(out);
     return out;
   }
 
  private:
+  // --- the baseline ------------------------------------------------------------
+
+  std::string RecordAt(const FixtureMonitor& out, long scan) const {
+    return Where(diags_, cycles_[out.records[static_cast<std::size_t>(scan - 1)]].where);
+  }
+  SourceRange RangeAt(const FixtureMonitor& out, long scan) const {
+    return cycles_[out.records[static_cast<std::size_t>(scan - 1)]].where;
+  }
+
+  // Phase I: the window of the first options_.baseline accepted scans from
+  // options_.baseline_from, each chart's reference estimated robustly.
+  bool Baseline(FixtureMonitor& out) {
+    FixtureBaseline& b = out.baseline;
+    b.fixture = fixture_.name;
+    std::vector<long> window;  // accepted scans in it
+    for (std::size_t i = 0; i < out.records.size(); ++i) {
+      const CycleRecord& record = cycles_[out.records[i]].record;
+      const long scan = static_cast<long>(i + 1);
+      if (scan < options_.baseline_from || !record.accepted() || !record.estimate) continue;
+      if (window.size() == options_.baseline) break;
+      window.push_back(scan);
+    }
+    const SourceRange first_where =
+        out.records.empty() ? SourceRange() : RangeAt(out, std::min<long>(options_.baseline_from, out.scans));
+    if (window.size() < options_.baseline) {
+      diags_.Report(DiagKind::MonitorTooFewScans, first_where,
+                    fmt::format("fixture '{}' has {} accepted scans from scan {} of the logs on: its baseline needs {} "
+                                "(--baseline; at least {}: with fewer, a chart guarded against its estimates' "
+                                "uncertainty no longer sees a step of 1.7 sigma); give longer logs, a smaller "
+                                "--baseline, or a stored baseline (--baseline-in)",
+                                fixture_.name, window.size(), options_.baseline_from, options_.baseline, kMinBaseline));
+      return false;
+    }
+    b.first_scan = window.front();
+    b.last_scan = window.back();
+    b.first_record = RecordAt(out, b.first_scan);
+    b.last_record = RecordAt(out, b.last_scan);
+    for (long scan = b.first_scan; scan <= b.last_scan; ++scan) {
+      const CycleRecord& record = cycles_[out.records[static_cast<std::size_t>(scan - 1)]].record;
+      ++b.scans;
+      if (const std::optional<ScanCheck> failed = record.failed()) {
+        ++b.refused[static_cast<std::size_t>(*failed) - 1];
+        ++b.refused_any;
+      }
+    }
+    // Each chart's reference; the scans of the window to exclude when one drifts.
+    bool ok = true;
+    struct DriftSaid {
+      Quantity quantity;
+      long first, last;
+      bool at_start;
+      double slope, t;
+    };
+    std::vector<DriftSaid> drifts;
+    std::vector<std::pair<Quantity, std::vector<long>>> outliers;
+    for (std::size_t q = 0; q < kQuantities; ++q) {
+      SeriesResult& series = out.series[q];
+      std::vector<double> values;
+      std::vector<long> scans;
+      for (std::size_t i = 0; i < series.values.size(); ++i) {
+        const auto scan = static_cast<long>(series.scan[i]);
+        if (scan < b.first_scan || scan > b.last_scan) continue;
+        values.push_back(series.values[i]);
+        scans.push_back(scan);
+      }
+      if (values.size() < kMinBaseline) continue;  // a chart the layout or the records do not give
+      const BaselineEstimate estimate = EstimateBaseline(values, kInfo[q].resolution);
+      for (std::size_t i : estimate.outliers) series.outliers.push_back(scans[i]);
+      if (!series.outliers.empty()) outliers.push_back({static_cast<Quantity>(q), series.outliers});
+      if (estimate.drift && kInfo[q].gates) {
+        drifts.push_back({static_cast<Quantity>(q), scans[estimate.drift->first], scans[estimate.drift->last],
+                          estimate.drift->at_start, estimate.drift->slope, estimate.drift->t});
+        continue;
+      }
+      if (estimate.reference.n < static_cast<long>(kMinBaseline)) {
+        diags_.Report(DiagKind::MonitorTooFewScans, RangeAt(out, b.first_scan),
+                      fmt::format("fixture '{}''s chart of the {} keeps {} of its baseline's {} values once its "
+                                  "outliers are left out: it needs at least {}; give a longer baseline (--baseline)",
+                                  fixture_.name, QuantityTitle(static_cast<Quantity>(q)), estimate.reference.n,
+                                  values.size(), kMinBaseline));
+        ok = false;
+        continue;
+      }
+      b.charts[q] = estimate.reference;
+    }
+    if (!outliers.empty()) {
+      std::string text;
+      for (const auto& [q, scans] : outliers) {
+        text += fmt::format("{}{} at scan{} {}", text.empty() ? "" : "; ", QuantityTitle(q), scans.size() == 1 ? "" : "s",
+                            ScanList(scans));
+      }
+      diags_.Report(DiagKind::MonitorBaselineOutliers, RangeAt(out, outliers.front().second.front()),
+                    fmt::format("fixture '{}''s baseline (scans {} to {}) holds values far from their neighbours (more "
+                                "than {} robust sigmas), left out of its charts' centre lines and sigmas: {}; if the "
+                                "cell was not as usual there, take the baseline elsewhere (--baseline-from)",
+                                fixture_.name, b.first_scan, b.last_scan, NumberText(kBaselineOutlierSigmas), text));
+    }
+    if (!drifts.empty()) {
+      // The scans to exclude: from the earliest start of a drift inside the
+      // window to its end, or from its start to the latest end of a warm-up.
+      long from = b.last_scan + 1, until = b.first_scan - 1;
+      std::string text;
+      for (const DriftSaid& d : drifts) {
+        if (d.at_start) {
+          until = std::max(until, d.last);
+        } else {
+          from = std::min(from, d.first);
+        }
+        text += fmt::format("{}{} {} {} {} per scan ({} standard errors) {}", text.empty() ? "" : "; ",
+                            QuantityTitle(d.quantity), d.slope >= 0 ? "rises" : "falls",
+                            NumberText(RoundedToDecimals(std::abs(d.slope), 3)), QuantityUnit(d.quantity),
+                            NumberText(RoundedToDecimals(std::abs(d.t), 1)),
+                            d.at_start ? fmt::format("until scan {}", d.last) : fmt::format("from scan {}", d.first));
+      }
+      std::string exclude, remedy;
+      if (until >= b.first_scan) {
+        exclude = fmt::format("scans {} to {}", b.first_scan, until);
+        remedy = fmt::format("start the baseline after them (--baseline-from {})", until + 1);
+      }
+      if (from <= b.last_scan) {
+        exclude += fmt::format("{}scans {} to {}", exclude.empty() ? "" : " and ", from, b.last_scan);
+        const long steady = from - std::max(b.first_scan, until + 1);
+        remedy += fmt::format("{}{}", remedy.empty() ? "" : ", or ",
+                              steady >= static_cast<long>(kMinBaseline)
+                                  ? fmt::format("end it before them (--baseline {})", steady)
+                                  : std::string("take it where the cell was steady (--baseline-from), or use a stored "
+                                                "baseline (--baseline-in)"));
+      }
+      diags_.Report(DiagKind::MonitorBaselineDrifts, RangeAt(out, from <= b.last_scan ? from : b.first_scan),
+                    fmt::format("fixture '{}''s baseline (scans {} to {}) drifts, so it is no reference: {}; exclude {}: "
+                                "{}",
+                                fixture_.name, b.first_scan, b.last_scan, text, exclude, remedy));
+      ok = false;
+    }
+    return ok;
+  }
+
+  // Phase II against a stored baseline.
+  bool Stored(const FixtureBaseline& stored, FixtureMonitor& out) {
+    out.baseline = stored;
+    out.baseline_stored = true;
+    return true;
+  }
+
+  // --- the scans -----------------------------------------------------------------
+
   // The record's verdict and pose against the cell's, from its own trips.
   std::optional<Eigen::Affine3d> Recompute(const CycleRecord& record, const std::optional<Eigen::Affine3d>& previous,
                                            long scan, FixtureMonitor& out) {
@@ -356,50 +585,71 @@ class FixtureAnalysis {
     }
   }
 
-  void Refusals(const std::vector<const CycleRecord*>& records, FixtureMonitor& out) {
-    const std::size_t baseline = std::min(options_.baseline, records.size());
-    for (ScanCheck check : kScanChecks) {
+  // --- the charts -----------------------------------------------------------------
+
+  // Every refusal together, then each check that refused a scan: a Bernoulli
+  // CUSUM designed from the baseline's rate, at least kRefusalRateFloor.
+  void Refusals(FixtureMonitor& out) {
+    const FixtureBaseline& b = out.baseline;
+    std::vector<std::optional<ScanCheck>> charts = {std::nullopt};
+    for (ScanCheck check : kScanChecks) charts.push_back(check);
+    for (const std::optional<ScanCheck>& check : charts) {
       RefusalResult refusal;
       refusal.check = check;
       std::vector<bool> events;
-      for (std::size_t i = 0; i < records.size(); ++i) {
-        const bool refused = records[i]->failed() == check;
+      events.reserve(out.records.size());
+      for (std::size_t i = 0; i < out.records.size(); ++i) {
+        const std::optional<ScanCheck> failed = cycles_[out.records[i]].record.failed();
+        const bool refused = check ? failed == check : failed.has_value();
         events.push_back(refused);
-        refusal.count += refused ? 1 : 0;
-        if (refused) refusal.at_scans.push_back(static_cast<long>(i + 1));
-        refusal.baseline_count += refused && i < baseline ? 1 : 0;
+        if (refused) {
+          ++refusal.count;
+          refusal.at_scans.push_back(static_cast<long>(i + 1));
+        }
       }
-      if (refusal.count == 0) continue;
-      // The in-control rate: the baseline's, pulled towards 1/2 by one
-      // refusal and one acceptance (Laplace), so a clean baseline does not
-      // make the first refusal an alarm.
-      refusal.p0 = (static_cast<double>(refusal.baseline_count) + 1) / (static_cast<double>(baseline) + 2);
-      const BernoulliCusumRun run = RunBernoulliCusum(events, DesignBernoulliCusum(std::max(refusal.p0, kRefusalRateFloor)));
-      if (run.alarm) refusal.alarm_scan = static_cast<long>(*run.alarm + 1);
-      out.refusals.push_back(refusal);
+      if (check && refusal.count == 0) continue;
+      refusal.baseline_count = check ? b.refused[static_cast<std::size_t>(*check) - 1] : b.refused_any;
+      refusal.baseline_scans = b.scans;
+      const double rate = b.scans > 0 ? static_cast<double>(refusal.baseline_count) / static_cast<double>(b.scans) : 0;
+      refusal.design = Design(std::max(rate, kRefusalRateFloor));
+      refusal.run = RunBernoulliCusum(events, refusal.design);
+      if (refusal.run.alarm) {
+        refusal.alarm_scan = static_cast<long>(*refusal.run.alarm + 1);
+        refusal.change_scan = static_cast<long>(refusal.run.change_point + 1);
+      }
+      out.refusals.push_back(std::move(refusal));
     }
   }
 
+  // The design for a rate, once per rate.
+  const BernoulliCusumDesign& Design(double p0) {
+    for (const BernoulliCusumDesign& d : designs_) {
+      if (d.p0 == p0) return d;
+    }
+    designs_.push_back(DesignBernoulliCusum(p0));
+    return designs_.back();
+  }
+
+  ChartOptions OptionsOf(std::size_t q) const {
+    ChartOptions chart;
+    chart.cusum_k = options_.cusum_k;
+    chart.cusum_h = options_.cusum_h;
+    chart.cusum_clip = options_.cusum_clip;
+    chart.ewma_lambda = options_.ewma_lambda;
+    chart.ewma_l = options_.ewma_l;
+    chart.direction = kInfo[q].direction;
+    chart.resolution = kInfo[q].resolution;
+    return chart;
+  }
+
   void Chart(FixtureMonitor& out) {
-    out.charted = out.accepted >= static_cast<long>(std::max<std::size_t>(options_.baseline, 2)) + 1;
     for (std::size_t q = 0; q < kQuantities; ++q) {
       SeriesResult& series = out.series[q];
       const auto kind = static_cast<Quantity>(q);
-      if (!series.values.empty()) {
-        const auto [limit_kind, limit] = LimitOf(kind);
-        out.process[q] = FiguresOf(series.values, options_.confidence, limit_kind, limit);
-      }
-      if (!out.charted || series.values.size() < std::max<std::size_t>(options_.baseline, 2) + 1) continue;
-      ChartOptions chart;
-      chart.baseline = options_.baseline;
-      chart.cusum_k = options_.cusum_k;
-      chart.cusum_h = options_.cusum_h;
-      chart.cusum_clip = options_.cusum_clip;
-      chart.ewma_lambda = options_.ewma_lambda;
-      chart.ewma_l = options_.ewma_l;
-      chart.direction = kInfo[q].direction;
-      chart.resolution = kInfo[q].resolution;
-      series.chart = RunChart(series.values, chart);
+      const std::optional<ChartReference>& reference = out.baseline.charts[q];
+      if (!reference || series.values.empty()) continue;
+      series.charted = true;
+      series.chart = RunChart(series.values, *reference, OptionsOf(q));
       if (series.chart.alarm) {
         series.trend = TrendFrom(series, series.scan[series.chart.change_point]);
         if (kind != Quantity::kResidualRms && kind != Quantity::kResidualMax) {
@@ -407,7 +657,6 @@ class FixtureAnalysis {
         }
       }
     }
-    if (out.charted) Findings(out);
   }
 
   // The mean since the change point against the centre line, in standard
@@ -416,13 +665,9 @@ class FixtureAnalysis {
     const std::vector<double> after(series.values.begin() + static_cast<std::ptrdiff_t>(series.chart.change_point),
                                     series.values.end());
     if (after.size() < 2) return true;
-    double mean = 0;
-    for (double v : after) mean += v;
-    mean /= static_cast<double>(after.size());
-    double squares = 0;
-    for (double v : after) squares += (v - mean) * (v - mean);
-    const double se = std::sqrt(squares / static_cast<double>(after.size() - 1) / static_cast<double>(after.size()));
-    return se == 0 || std::abs(mean - series.chart.center) > kShiftConfirmed * se;
+    const MeanSigma sample = MeanAndSigma(after);
+    const double se = sample.sigma / std::sqrt(static_cast<double>(after.size()));
+    return se == 0 || std::abs(sample.mean - series.chart.center) > kShiftConfirmed * se;
   }
 
   std::optional<Trend> TrendFrom(const SeriesResult& series, double from_scan) const {
@@ -456,7 +701,7 @@ class FixtureAnalysis {
   }
 
   // The first alarm among some charts: the finding's skeleton, or nullopt.
-  std::optional<Finding> Alarmed(const FixtureMonitor& out, FindingKind kind, std::initializer_list<Quantity> charts) {
+  std::optional<Finding> Alarmed(const FixtureMonitor& out, FindingKind kind, const std::vector<Quantity>& charts) {
     Finding finding;
     finding.kind = kind;
     bool any = false;
@@ -474,9 +719,93 @@ class FixtureAnalysis {
     return finding;
   }
 
+  // How far the board's measured origin moves (µm, base frame) per ppm the
+  // marker distance changes, when the robot's scale changes about its origin
+  // and the tables do not know it: the nominal trips where such a robot
+  // trips, through the fixture's estimator (for rigid, about the trips'
+  // centre; for paper and rigid-scale, about S1 itself).
+  std::optional<Eigen::Vector2d> OriginUmPerScalePpm() const {
+    constexpr double s = 1e-4;  // 100 ppm: linear, far above rounding
+    const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture_, nominal_);
+    std::vector<Eigen::Vector2d> seen;
+    for (const Eigen::Vector2d& t : trips) seen.push_back(t / (1 + s));
+    const std::optional<FixEstimate> before = EstimateFix(fixture_, ExpectedTrips(fixture_), trips, fixture_.estimator);
+    const std::optional<FixEstimate> after = EstimateFix(fixture_, ExpectedTrips(fixture_), seen, fixture_.estimator);
+    const std::optional<ScanDiagnostics::Fit> m0 = diagnostics_.Of(trips), m1 = diagnostics_.Of(seen);
+    if (!before || !after || !m0 || !m1 || std::abs(m1->scale_ppm - m0->scale_ppm) < 1) return std::nullopt;
+    return (FixOrigin(after->fix) - FixOrigin(before->fix)) * kUmPerMm / (m1->scale_ppm - m0->scale_ppm);
+  }
+
+  // A pose chart's drift that the marker distance's explains: a robot whose
+  // scale changes about its origin moves the board's measured origin too
+  // (OriginUmPerScalePpm). Each scan's pose is
+  // corrected by its own marker distance's change from the centre line and
+  // charted again, against the pose's reference with the sigma the
+  // correction adds (the marker distance's, times the lever).
+  ExplainedDrift Explain(const FixtureMonitor& out, Quantity q, const SeriesResult& scale) const {
+    const SeriesResult& pose = Series(out, q);
+    ExplainedDrift explained;
+    explained.quantity = q;
+    const double um_per_ppm = q == Quantity::kPoseX ? out.origin_um_per_ppm->x() : out.origin_um_per_ppm->y();
+    std::vector<double> corrected;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < pose.values.size(); ++i) {
+      while (k < scale.scan.size() && scale.scan[k] < pose.scan[i]) ++k;
+      if (k == scale.scan.size() || scale.scan[k] != pose.scan[i]) continue;  // a scan without a marker distance
+      corrected.push_back(pose.values[i] - (scale.values[k] - scale.chart.center) * um_per_ppm);
+    }
+    ChartReference reference = *out.baseline.charts[static_cast<std::size_t>(q)];
+    const double added = scale.chart.sigma_estimate * std::abs(um_per_ppm);
+    const double sigma = std::hypot(reference.sigma_estimate, added);
+    reference.mr_mean *= sigma / reference.sigma_estimate;
+    reference.sigma_estimate = sigma;
+    const ChartResult again = RunChart(corrected, reference, pose.chart.options);
+    explained.alarms_without = again.alarm.has_value();
+    explained.observed_per_100 = pose.trend ? pose.trend->slope * 100 : 0;
+    explained.explained_per_100 = scale.trend ? scale.trend->slope * um_per_ppm * 100 : 0;
+    return explained;
+  }
+
   void Findings(FixtureMonitor& out) {
-    if (std::optional<Finding> f = Alarmed(out, FindingKind::kFixtureMoving,
-                                           {Quantity::kPoseX, Quantity::kPoseY, Quantity::kPoseAngle})) {
+    // The robot's scale first: it moves the pose too.
+    std::vector<Quantity> pose_charts = {Quantity::kPoseX, Quantity::kPoseY, Quantity::kPoseAngle};
+    if (std::optional<Finding> f = Alarmed(out, FindingKind::kRobotScale, {Quantity::kMarkerScale})) {
+      const SeriesResult& scale = Series(out, Quantity::kMarkerScale);
+      if (const std::optional<Trend>& s = scale.trend) {
+        const double scale_ppm = s->at_end;
+        const double toward = scale_ppm >= 0 ? s->slope : -s->slope;
+        if (out.far_corner && out.far_corner->um_per_ppm > 0) {
+          const FarCorner& corner = *out.far_corner;
+          f->now = std::abs(scale_ppm) * corner.um_per_ppm;
+          f->per_scan = toward * corner.um_per_ppm;
+          f->limit = corner.MarginMm() * kUmPerMm;
+          f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
+        }
+        f->stale = Stale(scale_ppm);
+        out.origin_um_per_ppm = OriginUmPerScalePpm();
+        for (Quantity q : {Quantity::kPoseX, Quantity::kPoseY}) {
+          const SeriesResult& pose = Series(out, q);
+          if (!out.origin_um_per_ppm) break;
+          if (!pose.gates || !pose.chart.alarm || !pose.shift_confirmed) continue;
+          const ExplainedDrift e = Explain(out, q, scale);
+          f->explains.push_back(e);
+          if (!e.alarms_without) std::erase(pose_charts, q);
+        }
+      }
+      out.findings.push_back(*f);
+    }
+    if (std::optional<Finding> f =
+            Alarmed(out, FindingKind::kSensor, {Quantity::kSensorThreshold, Quantity::kResidualRms})) {
+      f->limit = fixture_.max_line_residual_mm * kUmPerMm;
+      if (const std::optional<Trend> r =
+              TrendFrom(Series(out, Quantity::kResidualMax), static_cast<double>(f->change_scan))) {
+        f->now = r->at_end;
+        f->per_scan = r->slope;
+        f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
+      }
+      out.findings.push_back(*f);
+    }
+    if (std::optional<Finding> f = Alarmed(out, FindingKind::kFixtureMoving, pose_charts)) {
       const std::optional<Trend> x = TrendFrom(Series(out, Quantity::kPoseX), static_cast<double>(f->change_scan));
       const std::optional<Trend> y = TrendFrom(Series(out, Quantity::kPoseY), static_cast<double>(f->change_scan));
       const std::optional<Trend> a =
@@ -496,39 +825,17 @@ class FixtureAnalysis {
       }
       out.findings.push_back(*f);
     }
-    if (std::optional<Finding> f = Alarmed(out, FindingKind::kRobotScale, {Quantity::kMarkerScale})) {
-      const std::optional<Trend> s = TrendFrom(Series(out, Quantity::kMarkerScale), static_cast<double>(f->change_scan));
-      if (s) {
-        const double scale_ppm = s->at_end;
-        const double toward = scale_ppm >= 0 ? s->slope : -s->slope;
-        if (out.far_corner && out.far_corner->um_per_ppm > 0) {
-          const FarCorner& corner = *out.far_corner;
-          f->now = std::abs(scale_ppm) * corner.um_per_ppm;
-          f->per_scan = toward * corner.um_per_ppm;
-          f->limit = corner.MarginMm() * kUmPerMm;
-          f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
-        }
-        f->stale = Stale(scale_ppm);
-      }
-      out.findings.push_back(*f);
-    }
-    if (std::optional<Finding> f =
-            Alarmed(out, FindingKind::kSensor, {Quantity::kSensorThreshold, Quantity::kResidualRms})) {
-      f->limit = fixture_.max_line_residual_mm * kUmPerMm;
-      if (const std::optional<Trend> r =
-              TrendFrom(Series(out, Quantity::kResidualMax), static_cast<double>(f->change_scan))) {
-        f->now = r->at_end;
-        f->per_scan = r->slope;
-        f->scans_to_limit = ScansTo(f->now, f->per_scan, f->limit);
-      }
-      out.findings.push_back(*f);
-    }
+    // Refusals: each check whose chart alarmed; the chart of every refusal
+    // together only when no check's did (the rise is spread over checks).
+    bool check_alarmed = false;
+    for (const RefusalResult& refusal : out.refusals) check_alarmed = check_alarmed || (refusal.check && refusal.alarm_scan);
     for (const RefusalResult& refusal : out.refusals) {
-      if (!refusal.alarm_scan) continue;
+      if (!refusal.alarm_scan || (!refusal.check && check_alarmed)) continue;
       Finding f;
       f.kind = FindingKind::kRefusals;
       f.check = refusal.check;
       f.alarm_scan = *refusal.alarm_scan;
+      f.change_scan = refusal.change_scan;
       out.findings.push_back(f);
     }
     out.in_control = out.findings.empty();
@@ -556,8 +863,11 @@ class FixtureAnalysis {
   const cell::Cell& cell_;
   const cell::Fixture& fixture_;
   const MonitorOptions& options_;
+  const std::vector<MonitoredCycle>& cycles_;
+  Diagnostics& diags_;
   ScanDiagnostics diagnostics_;
   Eigen::Affine3d nominal_;
+  std::vector<BernoulliCusumDesign> designs_;
 };
 
 }  // namespace
@@ -565,21 +875,64 @@ class FixtureAnalysis {
 std::string_view QuantityName(Quantity quantity) { return Info(quantity).name; }
 std::string_view QuantityTitle(Quantity quantity) { return Info(quantity).title; }
 std::string_view QuantityUnit(Quantity quantity) { return Info(quantity).unit; }
+bool QuantityGates(Quantity quantity) { return Info(quantity).gates; }
+std::optional<Quantity> QuantityNamed(std::string_view name) {
+  for (std::size_t q = 0; q < kQuantities; ++q) {
+    if (kInfo[q].name == name) return static_cast<Quantity>(q);
+  }
+  return std::nullopt;
+}
 
-MonitorResult Monitor(const cell::Cell& cell, const std::vector<MonitoredCycle>& cycles,
-                      const MonitorOptions& options) {
+MonitorResult Monitor(const cell::Cell& cell, const std::vector<MonitoredCycle>& cycles, const MonitorOptions& options,
+                      const MonitorBaseline* stored, Diagnostics& diags) {
   MonitorResult result;
-  for (const cell::Fixture& fixture : cell.fixtures) {
-    std::vector<const CycleRecord*> records;
-    for (const MonitoredCycle& cycle : cycles) {
-      if (AsciiLowercase(cycle.fixture) == AsciiLowercase(RecordName(fixture.name))) records.push_back(&cycle.record);
+  const std::size_t errors_before = diags.error_count();
+  std::vector<std::vector<std::size_t>> by_fixture(cell.fixtures.size());
+  for (std::size_t i = 0; i < cycles.size(); ++i) {
+    for (std::size_t f = 0; f < cell.fixtures.size(); ++f) {
+      if (AsciiLowercase(cycles[i].fixture) == AsciiLowercase(RecordName(cell.fixtures[f].name))) {
+        by_fixture[f].push_back(i);
+      }
     }
-    if (records.empty()) continue;
-    FixtureAnalysis analysis(cell, fixture, options);
-    result.fixtures.push_back(analysis.Run(records));
+  }
+  // Positions the robot cannot reach: no scan's (a cell that declares its
+  // travel; each record said).
+  const bool travel_declared = cell.robot.limits[0].hi > cell.robot.limits[0].lo &&
+                               cell.robot.limits[1].hi > cell.robot.limits[1].lo;
+  for (std::size_t f = 0; f < cell.fixtures.size() && travel_declared; ++f) {
+    const Travel travel = TravelOf(cell, cell.fixtures[f]);
+    for (std::size_t i : by_fixture[f]) RecordInTravel(cycles[i], travel, cell.name, diags);
+  }
+  if (diags.error_count() > errors_before) return result;
+  for (std::size_t f = 0; f < cell.fixtures.size(); ++f) {
+    if (by_fixture[f].empty()) continue;
+    const FixtureBaseline* fixture_baseline = nullptr;
+    if (stored) {
+      for (const FixtureBaseline& b : stored->fixtures) {
+        if (AsciiLowercase(b.fixture) == AsciiLowercase(cell.fixtures[f].name)) fixture_baseline = &b;
+      }
+      if (fixture_baseline == nullptr) {
+        diags.Report(DiagKind::MonitorBaselineOtherCell, cycles[by_fixture[f].front()].where,
+                     fmt::format("the stored baseline has no fixture '{}': take a baseline of it (--baseline-out)",
+                                 cell.fixtures[f].name));
+        continue;
+      }
+    }
+    FixtureAnalysis analysis(cell, cell.fixtures[f], options, cycles, diags);
+    result.fixtures.push_back(analysis.Run(by_fixture[f], fixture_baseline));
     result.in_control = result.in_control && result.fixtures.back().in_control;
   }
+  result.judged = diags.error_count() == errors_before;
   return result;
+}
+
+MonitorBaseline BaselineOf(const MonitorResult& result, const cell::Cell& cell, const std::vector<std::string>& logs) {
+  MonitorBaseline baseline;
+  baseline.cell = cell.name;
+  for (const cell::CellFile& file : cell.files) baseline.files.push_back({file.path, file.sha256});
+  baseline.logs = logs;
+  for (const FixtureMonitor& f : result.fixtures) baseline.fixtures.push_back(f.baseline);
+  return baseline;
 }
 
 }  // namespace smtcal

@@ -74,6 +74,7 @@ struct Drift {
   double walk_mm = 0, scale_ppm = 0, threshold_mm = 0, scatter_mm = 0;
   Eigen::Vector2d about = Eigen::Vector2d(233, 85);  // the robot's scale grows about this point
   int start = 100;
+  double refused_before = 0, refused_after = 0;  // the chance a trip is missed, before and from `start` on
 };
 
 // Which side of its edge each trip's marker lies on (+1: the normal's).
@@ -113,13 +114,27 @@ std::vector<MonitoredCycle> Simulate(const cell::Cell& cell, const Drift& drift,
     const double scatter = 0.01 + steps * drift.scatter_mm;
     for (double side : inward) sensor.push_back(Uniform(rng, -scatter, scatter) + steps * drift.threshold_mm * side);
     const std::vector<Eigen::Vector2d> trips = test::SimulateTrips(fixture, seen, sensor);
+    std::vector<std::optional<Eigen::Vector2d>> present = test::Present(trips);
+    const double refused = n > drift.start ? drift.refused_after : drift.refused_before;
+    if (refused > 0 && Uniform(rng, 0, 1) < refused) present[3].reset();
     options.previous = previous;
-    const ScanResult scan = ScanFixture(fixture, test::Present(trips), options);
+    const ScanResult scan = ScanFixture(fixture, present, options);
     if (scan.ok()) previous = scan.fix;
-    cycles.push_back({"Board", RecordOfScan(0, n, 60.0 * n, scan)});
+    cycles.push_back({"Board", RecordOfScan(0, n, 60.0 * n, scan), n == 1, 0, SourceRange()});
   }
   return cycles;
 }
+
+// Monitor with its own diagnostics.
+struct Judged {
+  SourceManager sources;
+  Diagnostics diags{sources};
+  MonitorResult result;
+  Judged(const cell::Cell& cell, const std::vector<MonitoredCycle>& cycles, const MonitorOptions& options,
+         const MonitorBaseline* stored = nullptr)
+      : result(Monitor(cell, cycles, options, stored, diags)) {}
+  std::string Text() const { return diags.RenderText(); }
+};
 
 std::vector<FindingKind> Kinds(const FixtureMonitor& f) {
   std::vector<FindingKind> kinds;
@@ -133,7 +148,9 @@ TEST(CycleMonitor, EachDriftIsFoundByItsOwnChartAfterItBegan) {
   const cell::Cell cell = BoardCell();
   MonitorOptions options;
 
-  const MonitorResult steady = Monitor(cell, Simulate(cell, {}, 300, seed), options);
+  const Judged judged_steady(cell, Simulate(cell, {}, 300, seed), options);
+  const MonitorResult& steady = judged_steady.result;
+  EXPECT_TRUE(steady.judged) << judged_steady.Text();
   ASSERT_EQ(steady.fixtures.size(), 1u);
   EXPECT_TRUE(steady.in_control) << "false alarm on an in-control log";
   EXPECT_EQ(steady.fixtures[0].disagreements, 0);
@@ -156,7 +173,8 @@ TEST(CycleMonitor, EachDriftIsFoundByItsOwnChartAfterItBegan) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const cell::Cell& board = c.drift.threshold_mm != 0 ? wide : cell;
-    const MonitorResult result = Monitor(board, Simulate(board, c.drift, 300, seed), options);
+    const Judged judged(board, Simulate(board, c.drift, 300, seed), options);
+    const MonitorResult& result = judged.result;
     const FixtureMonitor& f = result.fixtures.at(0);
     EXPECT_FALSE(result.in_control);
     ASSERT_EQ(Kinds(f), std::vector<FindingKind>{c.kind});
@@ -168,7 +186,8 @@ TEST(CycleMonitor, EachDriftIsFoundByItsOwnChartAfterItBegan) {
     EXPECT_EQ(f.threshold_identifiable, &board == &wide);
   }
   // The scale's finding: the far corner's error grows as the drift does.
-  const MonitorResult scale = Monitor(cell, Simulate(cell, {.scale_ppm = 1.5}, 300, seed), options);
+  const Judged judged_scale(cell, Simulate(cell, {.scale_ppm = 1.5}, 300, seed), options);
+  const MonitorResult& scale = judged_scale.result;
   const Finding& finding = scale.fixtures[0].findings.at(0);
   const double at_end_ppm = 1.5 * 200, um_per_ppm = scale.fixtures[0].far_corner->um_per_ppm;
   EXPECT_NEAR(finding.now, at_end_ppm * um_per_ppm, 0.25 * at_end_ppm * um_per_ppm);
@@ -182,9 +201,112 @@ TEST(CycleMonitor, RecordsOfOtherTablesAreFound) {
   const std::vector<MonitoredCycle> cycles = Simulate(cell, {}, 40, 7);
   // This cell's table under marker 2 says 3 µm more than the controller's did.
   cell.regions[2] = test::RegionOf("marker2", Flat(315, 110, 30, 30, 0.003));
-  const MonitorResult result = Monitor(cell, cycles, MonitorOptions{});
+  const Judged judged(cell, cycles, MonitorOptions{});
+  const MonitorResult& result = judged.result;
   EXPECT_EQ(result.fixtures.at(0).disagreements, 40);
   EXPECT_GT(result.fixtures[0].worst_disagreement_mm, 1e-4);
+}
+
+
+TEST(CycleMonitor, RefusalsRisingFromOneToThreePercentAlarmWithinAFewHundredScans) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  const cell::Cell cell = BoardCell();
+  // A clean baseline, then 1 % of scans refused for 400 scans, then 3 %.
+  Drift drift;
+  drift.start = 500;
+  drift.refused_before = 0.01;
+  drift.refused_after = 0.03;
+  std::vector<MonitoredCycle> cycles = Simulate(cell, drift, 2000, seed);
+  const std::vector<MonitoredCycle> clean = Simulate(cell, {}, 100, seed + 1);
+  std::copy(clean.begin(), clean.end(), cycles.begin());  // the clean baseline
+  const Judged judged(cell, cycles, MonitorOptions{});
+  ASSERT_TRUE(judged.result.judged) << judged.Text();
+  const FixtureMonitor& f = judged.result.fixtures.at(0);
+  ASSERT_FALSE(f.refusals.empty());
+  const RefusalResult& all = f.refusals.front();
+  EXPECT_FALSE(all.check.has_value());
+  EXPECT_EQ(all.baseline_count, 0);
+  EXPECT_EQ(all.design.p0, kRefusalRateFloor) << "a clean baseline: designed for the floor";
+  ASSERT_TRUE(all.alarm_scan) << all.count << " refused";
+  EXPECT_GT(*all.alarm_scan, 500);
+  EXPECT_LT(*all.alarm_scan, 500 + 4 * all.design.arl1) << "within a few run lengths at 3 %";
+  ASSERT_FALSE(f.findings.empty());
+  EXPECT_EQ(f.findings.back().kind, FindingKind::kRefusals);
+}
+
+TEST(CycleMonitor, ABaselineThatDriftsIsRefusedWithTheScansToExcludeAndOutliersAreLeftOut) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  const cell::Cell cell = BoardCell();
+  // The board walks from scan 30 on, inside the baseline of 50.
+  const Judged drifting(cell, Simulate(cell, {.walk_mm = 0.01, .start = 30}, 200, seed), MonitorOptions{});
+  EXPECT_FALSE(drifting.result.judged);
+  EXPECT_NE(drifting.Text().find("error: fixture 'Board''s baseline (scans 1 to 50) drifts"), std::string::npos)
+      << drifting.Text();
+  EXPECT_NE(drifting.Text().find("exclude scans "), std::string::npos) << drifting.Text();
+  // Started after the drift's start the baseline is refused too; a steady one
+  // of the same log's first 25 scans is not.
+  MonitorOptions short_window;
+  short_window.baseline = 25;
+  const Judged steady(cell, Simulate(cell, {.walk_mm = 0.01, .start = 30}, 200, seed), short_window);
+  EXPECT_TRUE(steady.result.judged) << steady.Text();
+  EXPECT_FALSE(steady.result.in_control);
+
+  // One wild pose in the baseline: left out, said, and the chart not blinded.
+  std::vector<MonitoredCycle> cycles = Simulate(cell, {}, 200, seed);
+  const Judged clean(cell, cycles, MonitorOptions{});
+  auto& s1 = (*cycles[9].record.estimate)[0];
+  s1.x() += 0.5;  // 500 µm, as an edited record might say
+  const Judged wild(cell, cycles, MonitorOptions{});
+  ASSERT_TRUE(wild.result.judged) << wild.Text();
+  EXPECT_NE(wild.Text().find("warning: fixture 'Board''s baseline (scans 1 to 50) holds values far from their "
+                             "neighbours"),
+            std::string::npos)
+      << wild.Text();
+  const SeriesResult& x = wild.result.fixtures[0].series[0];
+  EXPECT_EQ(x.outliers, std::vector<long>{10});
+  EXPECT_LT(x.chart.sigma_estimate, 1.5 * clean.result.fixtures[0].series[0].chart.sigma_estimate);
+}
+
+TEST(CycleMonitor, AStoredBaselineJudgesAsTheWindowItCameFrom) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  const cell::Cell cell = BoardCell();
+  const std::vector<MonitoredCycle> cycles = Simulate(cell, {.walk_mm = 0.004}, 300, seed);
+  const Judged window(cell, cycles, MonitorOptions{});
+  ASSERT_TRUE(window.result.judged) << window.Text();
+  const MonitorBaseline baseline = BaselineOf(window.result, cell, {"a.log"});
+  const Judged stored(cell, cycles, MonitorOptions{}, &baseline);
+  ASSERT_TRUE(stored.result.judged) << stored.Text();
+  const FixtureMonitor &a = window.result.fixtures[0], &b = stored.result.fixtures[0];
+  for (std::size_t q = 0; q < kQuantities; ++q) {
+    EXPECT_EQ(a.series[q].chart.center, b.series[q].chart.center);
+    EXPECT_EQ(a.series[q].chart.sigma, b.series[q].chart.sigma);
+    EXPECT_EQ(a.series[q].chart.alarm, b.series[q].chart.alarm);
+  }
+  EXPECT_EQ(Kinds(a), Kinds(b));
+  EXPECT_TRUE(b.baseline_stored);
+}
+
+TEST(CycleMonitor, ARobotScaleAboutItsOriginExplainsThePoseDriftItCauses) {
+  const std::uint64_t seed = test::FixtureSeed();
+  SCOPED_TRACE(fmt::format("seed {} (SMTCAL_TEST_SEED)", seed));
+  const cell::Cell cell = BoardCell();
+  // About the robot's origin: the board's measured origin walks by s times
+  // its distance from it, and both the scale and the pose charts alarm.
+  const Judged judged(cell, Simulate(cell, {.scale_ppm = 3, .about = Eigen::Vector2d(0, 0)}, 300, seed),
+                      MonitorOptions{});
+  ASSERT_TRUE(judged.result.judged) << judged.Text();
+  const FixtureMonitor& f = judged.result.fixtures[0];
+  ASSERT_FALSE(f.findings.empty());
+  EXPECT_EQ(f.findings.front().kind, FindingKind::kRobotScale) << "the cause first";
+  EXPECT_FALSE(f.findings.front().explains.empty()) << "the pose drift it causes, under it";
+  for (const ExplainedDrift& e : f.findings.front().explains) {
+    EXPECT_FALSE(e.alarms_without) << QuantityName(e.quantity);
+    EXPECT_NEAR(e.explained_per_100, e.observed_per_100, 0.5 * std::abs(e.observed_per_100)) << QuantityName(e.quantity);
+  }
+  for (const Finding& finding : f.findings) EXPECT_NE(finding.kind, FindingKind::kFixtureMoving);
 }
 
 }  // namespace
