@@ -24,7 +24,7 @@
 
 namespace smtcal {
 
-inline constexpr double kBaselineOutlierSigmas = 5;
+inline constexpr double kBaselineOutlierSigmas = 10;
 inline constexpr double kBaselineDriftAlpha = 1e-3;  // two-sided, per chart
 
 struct BaselineDrift {

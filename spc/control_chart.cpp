@@ -293,7 +293,8 @@ ChartResult RunChart(const std::vector<double>& values, const ChartOptions& opti
   return RunChart(values, EstimateReference(first, options.resolution), options);
 }
 
-ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options) {
+ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options,
+                     std::size_t from) {
   ChartResult chart = Prepared(reference, options);
   const bool up = options.direction != Direction::kDown, down = options.direction != Direction::kUp;
   const std::size_t n = values.size();
@@ -308,9 +309,12 @@ ChartResult RunChart(const std::vector<double>& values, const ChartReference& re
     return count;
   };
   ChartStatistic statistic(options, chart.cusum_k, chart.centre_uncertainty);
-  std::size_t last_zero_up = 0, last_zero_down = 0;
-  bool zero_up_seen = false, zero_down_seen = false;
+  // Before `from` nothing is judged: a drift found after it began there at the earliest.
+  std::size_t last_zero_up = from > 0 ? from - 1 : 0, last_zero_down = last_zero_up;
+  bool zero_up_seen = from > 0, zero_down_seen = from > 0;
   std::optional<std::size_t> last_below, last_above;  // the EWMA's last value at or below / above the centre
+  if (from > 0) last_below = last_above = from - 1;
+  chart.started = from;
   for (std::size_t i = 0; i < n; ++i) {
     auto set = [&](ChartRule rule) { holds[static_cast<std::size_t>(rule)][i] = true; };
     if ((up && z[i] > 3) || (down && z[i] < -3)) set(ChartRule::kNelson1);
@@ -339,6 +343,7 @@ ChartResult RunChart(const std::vector<double>& values, const ChartReference& re
     if (i >= 1 && std::abs(values[i] - values[i - 1]) > kD4 * chart.mr_mean && chart.mr_mean > 0) {
       set(ChartRule::kMovingRange);
     }
+    if (i < from) continue;
     const ChartStatistic::Step step = statistic.Add(z[i]);
     if (step.cusum_up_alarm) set(ChartRule::kCusumUp);
     if (step.cusum_down_alarm) set(ChartRule::kCusumDown);
@@ -391,7 +396,9 @@ ChartTrace TraceChart(const std::vector<double>& values, const ChartResult& char
   ChartTrace trace;
   ChartStatistic statistic(chart.options, chart.cusum_k, chart.centre_uncertainty);
   for (std::size_t i = 0; i < values.size(); ++i) {
-    const ChartStatistic::Step step = statistic.Add(Standardized(values[i], chart));
+    // Before the chart started (ChartResult::started) its statistics are 0.
+    const ChartStatistic::Step step =
+        i < chart.started ? ChartStatistic::Step{} : statistic.Add(Standardized(values[i], chart));
     trace.cusum_up.push_back(step.cusum_up);
     trace.cusum_down.push_back(step.cusum_down);
     trace.ewma.push_back(step.ewma);

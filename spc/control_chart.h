@@ -160,10 +160,14 @@ struct ChartResult {
   ChartRule alarm_rule = ChartRule::kCusumUp;
   Direction alarm_direction = Direction::kBoth;
   std::size_t change_point = 0;
+  std::size_t started = 0;  // the value the CUSUM and the EWMA started at (RunChart's `from`)
 };
 
-// A chart of individual values against a reference.
-ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options);
+// A chart of individual values against a reference. The CUSUM and the
+// EWMA start at value `from` (0: the first; after an alarm that was no
+// shift, the chart starts again after it); the other rules run over all.
+ChartResult RunChart(const std::vector<double>& values, const ChartReference& reference, const ChartOptions& options,
+                     std::size_t from = 0);
 // ... against the plain estimate of the first options.baseline values (at
 // least 2: checked).
 ChartResult RunChart(const std::vector<double>& values, const ChartOptions& options);

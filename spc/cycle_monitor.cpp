@@ -650,12 +650,25 @@ class FixtureAnalysis {
       if (!reference || series.values.empty()) continue;
       series.charted = true;
       series.chart = RunChart(series.values, *reference, OptionsOf(q));
-      if (series.chart.alarm) {
+      const bool location = kind != Quantity::kResidualRms && kind != Quantity::kResidualMax;
+      // An alarm that is no shift of the mean (the values only spread more)
+      // does not end the chart: it starts again after it, so a shift later
+      // in a long log is still found. The first alarm is kept when no shift
+      // follows.
+      ChartResult first = series.chart;
+      while (series.chart.alarm && location) {
         series.trend = TrendFrom(series, series.scan[series.chart.change_point]);
-        if (kind != Quantity::kResidualRms && kind != Quantity::kResidualMax) {
-          series.shift_confirmed = ShiftConfirmed(series);
-        }
+        series.shift_confirmed = ShiftConfirmed(series);
+        if (series.shift_confirmed || *series.chart.alarm + 1 >= series.values.size()) break;
+        ChartResult next = RunChart(series.values, *reference, OptionsOf(q), *series.chart.alarm + 1);
+        if (!next.alarm) break;
+        series.chart = std::move(next);
       }
+      if (location && !series.shift_confirmed) {
+        series.chart = std::move(first);
+        series.trend = TrendFrom(series, series.scan[series.chart.change_point]);
+      }
+      if (series.chart.alarm && !location) series.trend = TrendFrom(series, series.scan[series.chart.change_point]);
     }
   }
 

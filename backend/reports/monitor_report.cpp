@@ -678,14 +678,16 @@ class Plot {
 
   // A series against x: a line through every point when few, else per
   // column of the plot the range of the values (one path).
-  std::string Series(const std::vector<double>& x, const std::vector<double>& y, std::string_view style) const {
+  std::string Series(const std::vector<double>& x, const std::vector<double>& y, std::string_view colour,
+                     double width) const {
     if (x.empty()) return "";
     if (x.size() <= kMostPoints) {
       std::string points;
       for (std::size_t i = 0; i < x.size(); ++i) {
         points += fmt::format("{}{},{}", i == 0 ? "" : " ", SvgNum(X(x[i])), SvgNum(Y(y[i])));
       }
-      return fmt::format("<polyline points=\"{}\" fill=\"none\" {}/>\n", points, style);
+      return fmt::format("<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\"/>\n", points, colour,
+                         SvgNum(width));
     }
     std::vector<double> lo(kColumns, std::numeric_limits<double>::infinity()),
         hi(kColumns, -std::numeric_limits<double>::infinity());
@@ -701,7 +703,7 @@ class Plot {
       const double px = kLeft + (static_cast<double>(c) + 0.5) * kPlotWidth / static_cast<double>(kColumns);
       path += fmt::format("M{} {}V{}", SvgNum(px), SvgNum(Y(lo[c]) + 0.5), SvgNum(Y(hi[c]) - 0.5));
     }
-    return fmt::format("<path d=\"{}\" fill=\"none\" {} stroke-width=\"{}\"/>\n", path, style,
+    return fmt::format("<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\"/>\n", path, colour,
                        SvgNum(kPlotWidth / static_cast<double>(kColumns)));
   }
 
@@ -772,16 +774,35 @@ std::string ChartSvg(const SeriesResult& series, const FixtureMonitor& f, double
   svg += values.HLine(chart.center, "stroke=\"#1f77b4\"");
   svg += values.HLine(chart.center + 3 * chart.sigma, "stroke=\"#d62728\" stroke-dasharray=\"5 3\"");
   if (!upward) svg += values.HLine(chart.center - 3 * chart.sigma, "stroke=\"#d62728\" stroke-dasharray=\"5 3\"");
-  svg += values.Series(series.scan, series.values, "stroke=\"#555\" stroke-width=\"0.8\"");
+  svg += values.Series(series.scan, series.values, "#555", 0.8);
+  // The points: every one when few; beyond 3 sigma red — when many, the
+  // farthest of each column of the plot, so they cover the whole range.
   const bool dots = series.values.size() <= kMostPoints / 2;
   std::string black, red;
-  std::size_t marks = 0;
+  std::vector<std::optional<std::size_t>> farthest(kColumns);
+  std::size_t beyond_count = 0;
+  auto z_of = [&](std::size_t i) { return chart.sigma > 0 ? (series.values[i] - chart.center) / chart.sigma : 0.0; };
   for (std::size_t i = 0; i < series.values.size(); ++i) {
-    const double z = chart.sigma > 0 ? (series.values[i] - chart.center) / chart.sigma : 0;
+    const double z = z_of(i);
     const bool beyond = upward ? z > 3 : std::abs(z) > 3;
-    if (!(beyond ? marks++ < kMostMarks : dots)) continue;
+    if (beyond) {
+      ++beyond_count;
+      const auto c = std::min(kColumns - 1, static_cast<std::size_t>(std::max(0.0, (values.X(series.scan[i]) - kLeft) /
+                                                                                        kPlotWidth * kColumns)));
+      if (!farthest[c] || std::abs(z) > std::abs(z_of(*farthest[c]))) farthest[c] = i;
+    }
+    if (!dots && !beyond) continue;
+    if (beyond && beyond_count > kMostMarks) continue;
     (beyond ? red : black) += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"{}\"/>", SvgNum(values.X(series.scan[i])),
                                           SvgNum(values.Y(series.values[i])), beyond ? "2.5" : "1.5");
+  }
+  if (beyond_count > kMostMarks) {
+    red.clear();
+    for (const std::optional<std::size_t>& i : farthest) {
+      if (!i) continue;
+      red += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"2.5\"/>", SvgNum(values.X(series.scan[*i])),
+                         SvgNum(values.Y(series.values[*i])));
+    }
   }
   if (!black.empty()) svg += "<g fill=\"#333\">" + black + "</g>\n";
   if (!red.empty()) svg += "<g fill=\"#d62728\">" + red + "</g>\n";
@@ -802,9 +823,14 @@ std::string ChartSvg(const SeriesResult& series, const FixtureMonitor& f, double
                          SvgNum(values.X(change)), SvgNum(values.Y(y0)), SvgNum(values.X(t.end_x)),
                          SvgNum(values.Y(t.at_end)));
     }
+    bool explained = false;
+    for (const Finding& finding : f.findings) {
+      for (const ExplainedDrift& e : finding.explains) explained = explained || (e.quantity == series.quantity && !e.alarms_without);
+    }
     lines.push_back({fmt::format("{} alarm at scan {}{}", ChartRuleName(chart.alarm_rule), static_cast<long>(alarm),
                                  series.shift_confirmed ? "" : " (no shift)"),
                      series.gates && series.shift_confirmed});
+    if (explained) lines.push_back({"the robot's scale explains it", true});
     lines.push_back({fmt::format("the drift began about scan {}", static_cast<long>(change)), false});
   }
   svg += FiguresBeside(top, lines);
@@ -824,9 +850,9 @@ std::string ChartSvg(const SeriesResult& series, const FixtureMonitor& f, double
     down[i] = -trace.cusum_down[i] / chart.options.cusum_h;
     ewma[i] = trace.ewma_limit[i] > 0 ? trace.ewma[i] / trace.ewma_limit[i] : 0;
   }
-  svg += decision.Series(series.scan, up, "stroke=\"#1f77b4\" stroke-width=\"1.2\"");
-  if (!upward) svg += decision.Series(series.scan, down, "stroke=\"#1f77b4\" stroke-width=\"1.2\"");
-  svg += decision.Series(series.scan, ewma, "stroke=\"#2ca02c\" stroke-width=\"1.2\"");
+  svg += decision.Series(series.scan, up, "#1f77b4", 1.2);
+  if (!upward) svg += decision.Series(series.scan, down, "#1f77b4", 1.2);
+  svg += decision.Series(series.scan, ewma, "#2ca02c", 1.2);
   if (chart.alarm) svg += decision.VLine(series.scan[*chart.alarm], "stroke=\"#d62728\" stroke-width=\"2\"");
   svg += FiguresBeside(decision_top, {{"blue: CUSUM / h (up; down below 0)", false},
                                       {fmt::format("green: EWMA / its limit (L {})", NumberText(chart.options.ewma_l)), false},
@@ -837,11 +863,11 @@ std::string ChartSvg(const SeriesResult& series, const FixtureMonitor& f, double
   double most = chart.mr_mean * 3.267;
   for (double r : trace.moving_range) most = std::max(most, r);
   const Plot range(range_top, kRangeHeight, scans, AxisOver(0, most, 2));
-  svg += range.Frame("MR", false);
+  svg += range.Frame("MR", true);
   svg += Restarts(range, f, false);
   svg += range.HLine(chart.mr_mean, "stroke=\"#1f77b4\"");
   svg += range.HLine(chart.mr_mean * 3.267, "stroke=\"#d62728\" stroke-dasharray=\"5 3\"");
-  svg += range.Series(series.scan, trace.moving_range, "stroke=\"#777\" stroke-width=\"0.8\"");
+  svg += range.Series(series.scan, trace.moving_range, "#777", 0.8);
   svg += FiguresBeside(range_top, {{fmt::format("moving range: mean {}, limit {}", Fixed(chart.mr_mean, kDecimals + 1),
                                                 Fixed(chart.mr_mean * 3.267, kDecimals + 1)),
                                     false}});
@@ -870,7 +896,7 @@ std::string RefusalsSvg(const FixtureMonitor& f, double top, const Axis& scans) 
     const char* colour = r == 0 ? "#333" : kColours[(r - 1) % kColours.size()];
     std::vector<double> y(refusal.run.sum.size());
     for (std::size_t i = 0; i < y.size(); ++i) y[i] = static_cast<double>(refusal.run.sum[i]) / refusal.design.limit;
-    svg += plot.Series(x, y, fmt::format("stroke=\"{}\" stroke-width=\"1.2\"", colour));
+    svg += plot.Series(x, y, colour, 1.2);
     std::string ticks;
     for (std::size_t i = 0; i < refusal.at_scans.size() && i < kMostMarks; ++i) {
       const double px = plot.X(static_cast<double>(refusal.at_scans[i]));
@@ -886,8 +912,8 @@ std::string RefusalsSvg(const FixtureMonitor& f, double top, const Axis& scans) 
                      refusal.alarm_scan.has_value()});
   }
   if (f.refusals.size() > kColours.size()) lines.push_back({fmt::format("({} more checks: see the report)", f.refusals.size() - kColours.size()), false});
-  lines.push_back({"designed for the baseline's rate (at least 1 %)", false});
-  lines.push_back({"to catch 3 times it", false});
+  lines.push_back({"each designed for its baseline rate", false});
+  lines.push_back({"(at least 1 %), to catch 3 times it", false});
   svg += FiguresBeside(top, lines);
   // The scan axis under the last panel.
   for (double t : SvgTicks(scans.lo, scans.hi, scans.step)) {
@@ -900,7 +926,7 @@ std::string RefusalsSvg(const FixtureMonitor& f, double top, const Axis& scans) 
   return svg;
 }
 
-constexpr double kChartHeight = kValuesHeight + kDecisionHeight + kRangeHeight + 2 * kPanelGap + 38;
+constexpr double kChartHeight = kValuesHeight + kDecisionHeight + kRangeHeight + 2 * kPanelGap + 50;
 
 }  // namespace
 
@@ -946,7 +972,7 @@ std::string MonitorReportSvg(const MonitorResult& result, const MonitorContext& 
     body += fmt::format("<text x=\"{}\" y=\"{}\" font-size=\"15\" font-weight=\"bold\">fixture {}: {} scans, {} "
                         "accepted{}</text>\n",
                         kLeft, SvgNum(y + 12), SvgEscape(f.name), f.scans, f.accepted,
-                        f.restarts.empty() ? "" : fmt::format(", {} restarts", f.restarts.size()));
+                        f.restarts.empty() ? "" : fmt::format(", {} restart{}", f.restarts.size(), f.restarts.size() == 1 ? "" : "s"));
     y += 18;
     if (!f.charted) {
       body += fmt::format("<text x=\"{}\" y=\"{}\">no baseline: not judged</text>\n", kLeft, SvgNum(y + 12));
@@ -956,7 +982,9 @@ std::string MonitorReportSvg(const MonitorResult& result, const MonitorContext& 
     body += fmt::format("<text x=\"{}\" y=\"{}\" font-size=\"11\">baseline: {}</text>\n", kLeft, SvgNum(y + 12),
                         SvgEscape(BaselineText(f, context)));
     y += 40;
-    const Axis scans = AxisOver(0.5, static_cast<double>(std::max<long>(f.scans, 2)) + 0.5, 10, 1);
+    // The scans, from the first to the last (ticks at round numbers inside).
+    const double last_scan = static_cast<double>(std::max<long>(f.scans, 2));
+    const Axis scans{0.5, last_scan + 0.5, std::max(1.0, SvgTickStep(last_scan, 10))};
     // The charts of the findings first (in their order), then the others.
     std::vector<Quantity> order;
     bool refusals_alarmed = false;

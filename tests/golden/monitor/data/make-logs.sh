@@ -66,8 +66,8 @@ awk '$1 == "trip" && $3 == 5 && $4 == 1 { held = $0; next } { print } $1 == "tri
   "$base" > $out/warn_record_damaged_out_of_order.log
 # The log given twice (warn_record_repeated.args names it twice).
 cp "$base" $out/warn_record_repeated.log
-# One baseline record's S1 moved by 0.5 mm: an outlier the baseline leaves out.
-awk '$1 == "cycle" && $3 == 5 { $7 = sprintf("%.9f", $7 + 0.5) } { print }' "$base" \
+# One baseline record's S1 moved by 1.5 mm: an outlier the baseline leaves out.
+awk '$1 == "cycle" && $3 == 5 { $7 = sprintf("%.9f", $7 + 1.5) } { print }' "$base" \
   > $out/warn_monitor_baseline_outliers.log
 # Values no scan gives: S1 x of 1e300; S1 at (1000, 1000) mm, outside the
 # robot's travel; check 7 (line_residual) of 1e300; a time before the last.
