@@ -140,10 +140,12 @@ BENCHMARK(BM_MonitorRunLengthGuarded)
     ->Unit(benchmark::kSecond);
 
 // The one-sided CUSUM S = max(0, S + clip(z, -c, c) - k) for normal z: its
-// in-control run length from 0 to h, by the Markov chain on `m` states of
-// width h / m (Brook and Evans 1972; the state's value is its midpoint).
+// in-control run length from 0 to h, by the Markov chain on `m` transient
+// states (Brook and Evans 1972): state 0 holds [0, w/2), state j the
+// interval of width w = 2h / (2m - 1) about j w (its value), and S >= h =
+// (m - 1/2) w is the alarm.
 double CusumMarkovChain(double k, double h, double clip, int m) {
-  const double w = h / m;
+  const double w = 2 * h / (2 * m - 1);
   auto cdf = [](double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); };
   // The increment's distribution: z clipped, minus k.
   auto below = [&](double x) {  // P(clip(z) - k < x)
@@ -154,10 +156,9 @@ double CusumMarkovChain(double k, double h, double clip, int m) {
   };
   Eigen::MatrixXd a = Eigen::MatrixXd::Identity(m, m);
   for (int i = 0; i < m; ++i) {
-    const double from = i == 0 ? 0 : (i + 0.5) * w;
-    // to state 0: S + d <= w / 2 (the zero state holds [0, w/2))
-    a(i, 0) -= below(w / 2 - from);
-    for (int j = 1; j < m; ++j) a(i, j) -= below((j + 0.5) * w + w / 2 - from) - below((j + 0.5) * w - w / 2 - from);
+    const double from = i * w;
+    a(i, 0) -= below(w / 2 - from);  // to state 0: S + d < w / 2 (the reset at 0 included)
+    for (int j = 1; j < m; ++j) a(i, j) -= below((j + 0.5) * w - from) - below((j - 0.5) * w - from);
   }
   const Eigen::VectorXd arl = a.partialPivLu().solve(Eigen::VectorXd::Ones(m));
   return arl(0);
