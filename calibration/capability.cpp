@@ -32,22 +32,23 @@ double Cmk(double tolerance_mm, double mean_mm, double sigma_mm) {
   return margin / (3 * sigma_mm);
 }
 
+double CmkUpper(double limit, double mean, double sigma) {
+  const double margin = limit - mean;
+  if (sigma <= 0) return margin > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return margin / (3 * sigma);
+}
+
 void SampleCapability::Add(const Eigen::Vector2d& error_mm, double tolerance_mm) {
-  tolerance_mm_ = n_ == 0 ? tolerance_mm : std::min(tolerance_mm_, tolerance_mm);
-  ++n_;
-  sum_ += error_mm;
-  sum_squares_ += error_mm * error_mm.transpose();
+  tolerance_mm_ = moments_.count() == 0 ? tolerance_mm : std::min(tolerance_mm_, tolerance_mm);
+  moments_.Add(error_mm);
 }
 
 Capability SampleCapability::Result() const {
-  if (n_ == 0) return Capability{};
-  const double n = static_cast<double>(n_);
-  const Eigen::Vector2d mean = sum_ / n;
+  if (moments_.count() == 0) return Capability{};
   // The sample covariance (n - 1); a single placement has no spread.
-  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
-  if (n_ > 1) covariance = (sum_squares_ - n * mean * mean.transpose()) / (n - 1);
-  Capability c = Figures(n_, tolerance_mm_, mean, covariance);
-  c.ppm_outside = 1e6 * OutsideProbability(mean, covariance, tolerance_mm_);
+  const Eigen::Matrix2d covariance = moments_.Covariance();
+  Capability c = Figures(moments_.count(), tolerance_mm_, moments_.mean(), covariance);
+  c.ppm_outside = 1e6 * OutsideProbability(moments_.mean(), covariance, tolerance_mm_);
   return c;
 }
 
@@ -61,19 +62,19 @@ void ModelCapability::Add(const Eigen::Vector2d& mean_mm, double bound_mm, const
     direction = solver.eigenvectors().col(1);
   }
   const Eigen::Vector2d mean = mean_mm + bound_mm * direction.normalized();
-  tolerance_mm_ = n_ == 0 ? tolerance_mm : std::min(tolerance_mm_, tolerance_mm);
-  ++n_;
-  sum_mean_ += mean;
-  sum_second_ += covariance_mm2 + mean * mean.transpose();
+  tolerance_mm_ = means_.count() == 0 ? tolerance_mm : std::min(tolerance_mm_, tolerance_mm);
+  means_.Add(mean);
+  sum_covariance_ += covariance_mm2;
   sum_outside_ += OutsideProbability(mean, covariance_mm2, tolerance_mm);
 }
 
 Capability ModelCapability::Result() const {
-  if (n_ == 0) return Capability{};
-  const double n = static_cast<double>(n_);
-  const Eigen::Vector2d mean = sum_mean_ / n;
-  const Eigen::Matrix2d covariance = sum_second_ / n - mean * mean.transpose();
-  Capability c = Figures(n_, tolerance_mm_, mean, covariance);
+  if (means_.count() == 0) return Capability{};
+  const double n = static_cast<double>(means_.count());
+  // The mixture's covariance: the mean of the random parts' plus the
+  // spread of the means about their mean (over n, the mixture's own).
+  const Eigen::Matrix2d covariance = sum_covariance_ / n + means_.Covariance() * ((n - 1) / n);
+  Capability c = Figures(means_.count(), tolerance_mm_, means_.mean(), covariance);
   c.ppm_outside = 1e6 * sum_outside_ / n;
   return c;
 }

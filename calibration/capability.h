@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 
+#include "calibration/sample_statistics.h"
+
 namespace smtcal {
 
 inline constexpr double kReferenceToleranceMm = 0.050;
@@ -27,8 +29,11 @@ struct Capability {
   double WorstCmk() const { return cmk.minCoeff(); }
 };
 
-// Cmk of one axis; +infinity for a spread of zero inside the tolerance.
+// Cmk of one axis, (T - |mean|) / 3 sigma for a tolerance +-T; +infinity
+// for a spread of zero inside the tolerance. CmkUpper: the one-sided index
+// (limit - mean) / 3 sigma of a quantity bounded only from above.
 double Cmk(double tolerance_mm, double mean_mm, double sigma_mm);
+double CmkUpper(double limit, double mean, double sigma);
 
 // From placement errors (sample vectors, where the part landed minus where it
 // belongs): the sample's mean and covariance, and a normal fitted to them.
@@ -38,10 +43,8 @@ class SampleCapability {
   Capability Result() const;
 
  private:
-  long n_ = 0;
   double tolerance_mm_ = 0;
-  Eigen::Vector2d sum_ = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d sum_squares_ = Eigen::Matrix2d::Zero();
+  SampleMoments<2> moments_;
 };
 
 // From the budget's model of each placement: a known mean, an unknown
@@ -55,10 +58,9 @@ class ModelCapability {
   Capability Result() const;
 
  private:
-  long n_ = 0;
   double tolerance_mm_ = 0;
-  Eigen::Vector2d sum_mean_ = Eigen::Vector2d::Zero();
-  Eigen::Matrix2d sum_second_ = Eigen::Matrix2d::Zero();  // E[e e^T] summed
+  SampleMoments<2> means_;                                      // of the placements' means
+  Eigen::Matrix2d sum_covariance_ = Eigen::Matrix2d::Zero();  // their random parts' covariances, summed
   double sum_outside_ = 0;
 };
 

@@ -115,8 +115,11 @@ inline constexpr NumberRange kSimCycles = Whole(1, kSimMaxCycles);
 inline constexpr NumberRange kSimSeed = Whole(0, 18446744073709551615.0);
 inline constexpr NumberRange kProbability = Closed(0, 1, "");
 inline constexpr NumberRange kDirtyMarkerMm = Closed(0, 10, "mm");
-// monitor --baseline: the accepted scans per fixture that set the charts.
-inline constexpr NumberRange kMonitorBaseline = Whole(2, 1'000'000);
+// monitor --baseline: the accepted scans per fixture that set the charts
+// (at least spc/cycle_monitor.h's kMinBaseline, docs/monitor.md); and
+// --baseline-from: the scan the baseline starts at.
+inline constexpr NumberRange kMonitorBaseline = Whole(10, 1'000'000);
+inline constexpr NumberRange kMonitorBaselineFrom = Whole(1, 2'000'000'000);
 // table inverse --paper-tolerance: the paper solver's stopping tolerance.
 inline constexpr NumberRange kPaperToleranceMm = AboveZero(1, "mm");
 // import --vacuum: an output bit.

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "backend/reports/svg_text.h"
+#include "base/csv_field.h"
 #include "base/field_text.h"
 #include "calibration/error_table.h"
 #include "calibration/tolerances.h"
@@ -277,14 +278,6 @@ std::string Joined(const std::vector<std::string>& items, std::string_view separ
 // "lane 3", "pocket 12", or "-" for a feeder's single pick point.
 std::string SlotText(const SetupSlot& slot) {
   return slot.slot_kind.empty() ? std::string("-") : fmt::format("{} {}", slot.slot_kind, slot.slot);
-}
-
-// One CSV field (RFC 4180): quoted when it holds a comma, a quote or a line end.
-std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
 }
 
 // Width of a text in columns: UTF-8 characters, not bytes (µ, Ω in values).

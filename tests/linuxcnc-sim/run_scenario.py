@@ -162,8 +162,8 @@ def drifting(cycles, start, walk_mm, scale_ppm, seed=30):
 
 MONITOR_CELL = {"record_clock_pin": '"smtcal-clock.out"'}
 SCENARIOS["monitor_drift"] = {"program": MONITOR, "expect": "ok", "cell_add": MONITOR_CELL,
-                              "monitor": {"baseline": 6, "start": 6, "walk_mm": 0.02, "scale_ppm": 25},
-                              "cycles": drifting(13, 6, 0.02, 25)}
+                              "monitor": {"baseline": 10, "start": 10, "walk_mm": 0.02, "scale_ppm": 25},
+                              "cycles": drifting(17, 10, 0.02, 25)}
 SCENARIOS["monitor_drift_long"] = {"program": MONITOR, "expect": "ok", "cell_add": MONITOR_CELL,
                                    "monitor": {"baseline": 20, "start": 25, "walk_mm": 0.005, "scale_ppm": 4},
                                    "cycles": drifting(60, 25, 0.005, 4)}
@@ -898,8 +898,8 @@ def check_monitor(args, scenario, cell, log_path):
     tolerance."""
     m = scenario["monitor"]
     result = smtcal(["monitor", log_path, "--cell", cell, "--baseline", str(m["baseline"]), "--json"], args.smtcal)
-    if result.returncode != 1:
-        fail(f"smtcal monitor: exit {result.returncode}, expected 1 (out of control)\n{result.stdout}{result.stderr}")
+    if result.returncode != 4:
+        fail(f"smtcal monitor: exit {result.returncode}, expected 4 (out of control)\n{result.stdout}{result.stderr}")
     report = json.loads(result.stdout)
     board = report["fixtures"][0]
     findings = {f["kind"]: f for f in board["findings"]}
