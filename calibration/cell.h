@@ -163,6 +163,11 @@ struct ScanPath {
 
 enum class Estimator { kPaper, kRigid, kRigidScale };
 
+// predicted_window_mm without the key, in sensor accuracies: the two scans'
+// trips are each within the sensor's accuracy of their edges (2), the rest
+// is for the board's change between cycles (4).
+inline constexpr double kDefaultPredictedWindowAccuracies = 6;
+
 // [[fixture]]
 struct Fixture {
   std::string name;  // bound to the program's `Fixture NAME` (case-insensitive)
@@ -192,6 +197,13 @@ struct Fixture {
   // two stages, else scan_speed_mm_s. A trip lands up to this times the
   // servo period past its edge.
   double TripLatchSpeedMmS() const { return latch_speed_mm_s > 0 ? latch_speed_mm_s : scan_speed_mm_s; }
+  // Predicted search (docs/periphery.md, "Searches predicted from the last
+  // scan"): every scan after a fixture's first latches each trip within this
+  // distance either side of where the last scan's FIX puts it, and searches
+  // the path in full when a trip is not there. 0 (the key absent): every
+  // scan searches in full. A time, not a limit: it refuses no board. The
+  // loader's default is kDefaultPredictedWindowAccuracies x sensor_accuracy_mm.
+  double predicted_window_mm = 0;
   double trip_window_mm = 0;     // a trip is expected within this distance of its nominal point along the leg
   int sensor_input = 0;          // digital input the sensor is wired to
   double sensor_accuracy_mm = 0; // +- where the sensor trips against the true edge

@@ -73,6 +73,7 @@ inline constexpr NumberRange kDwellS = Closed(0, 3600, "s");
 inline constexpr NumberRange kTimeoutS = AboveZero(3600, "s");
 // A fixture's trip window and its check limits.
 inline constexpr NumberRange kTripWindowMm = AboveZero(100, "mm");
+inline constexpr NumberRange kPredictedWindowMm = Closed(0, 100, "mm");  // 0: no predicted search
 // A fixture's pocket (pocket_x_mm, pocket_y_mm): bounds in the fixture frame.
 inline constexpr NumberRange kPocketMm = Closed(-2000, 2000, "mm");
 inline constexpr NumberRange kFixtureLimitMm = AboveZero(100, "mm");

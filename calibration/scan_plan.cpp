@@ -228,28 +228,117 @@ CaptureRange ScanCaptureRange(const cell::Fixture& fixture) {
   return range;
 }
 
-ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from) {
+namespace {
+
+// The runtime makes no probe move shorter than this in both axes (LinuxCNC
+// refuses one shorter than 0.01 mm: "start point too close to probe point").
+constexpr double kShortestProbeMoveMm = 0.02;
+
+// A trip of a path as the runtime reaches it: its leg in the base frame at
+// the nominal pose (start, unit direction) and where along it the edge is.
+struct PathTrip {
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
+  std::size_t leg = 0;
+  double along_mm = 0;
+  Eigen::Vector2d At(double along) const { return start + along * direction; }
+};
+std::vector<PathTrip> TripsOfPath(const cell::Fixture& fixture, const std::vector<ExpectedTrip>& expected,
+                                  std::size_t p) {
+  const Eigen::Affine3d nominal = NominalFix(fixture);
+  const std::vector<cell::Point2>& points = fixture.scan_paths[p].points;
+  std::vector<PathTrip> trips;
+  for (const ExpectedTrip& trip : expected) {
+    if (trip.path != p) continue;
+    const Eigen::Vector2d a = ToBase(nominal, points[trip.leg]), b = ToBase(nominal, points[trip.leg + 1]);
+    trips.push_back({a, (b - a).normalized(), trip.leg, trip.along_mm});
+  }
+  return trips;
+}
+
+// Up from `at` to the safe z and across to `to` (when `at` is known), then
+// down to the scan z.
+double JumpSeconds(const cell::Robot& robot, const cell::Fixture& fixture, bool known, const ScanPoint& at,
+                   const Eigen::Vector2d& to) {
+  double seconds = 0;
+  if (known) {
+    seconds += MoveTime(robot.safe_limz_mm - at.z(), robot.z_speed_mm_s, robot.z_accel_mm_s2);
+    seconds += MoveTime((to - at.head<2>()).norm(), robot.xy_speed_mm_s, robot.xy_accel_mm_s2);
+  }
+  return seconds + MoveTime(robot.safe_limz_mm - fixture.scan_z_mm, robot.z_speed_mm_s, robot.z_accel_mm_s2);
+}
+
+double RiseSeconds(const cell::Robot& robot, const cell::Fixture& fixture) {
+  return MoveTime(robot.safe_limz_mm - fixture.scan_z_mm, robot.z_speed_mm_s, robot.z_accel_mm_s2);
+}
+
+// The moves' turnarounds and the total, the scan ending at `end`.
+ScanTiming Finished(ScanTiming timing, const cell::Robot& robot, const ScanPoint& end) {
+  timing.turnaround_s = timing.probe_moves * robot.probe_turnaround_s;
+  timing.seconds = timing.travel_s + timing.search_s + timing.latch_s + timing.turnaround_s;
+  timing.end = end;
+  return timing;
+}
+
+}  // namespace
+
+ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from,
+                    ScanSearch search) {
   const Eigen::Affine3d nominal = NominalFix(fixture);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
-  const double a = robot.xy_accel_mm_s2, search = fixture.scan_speed_mm_s, latch = fixture.latch_speed_mm_s;
+  const double a = robot.xy_accel_mm_s2, latch = fixture.latch_speed_mm_s;
   const double period = robot.servo_period_s;
+  const double window = fixture.predicted_window_mm;
   ScanTiming timing;
   bool known = from.has_value();  // where the robot stands (a plain flag and point: GCC warns on optional<Eigen>)
   ScanPoint at = known ? *from : ScanPoint::Zero();
+  if (search == ScanSearch::kPredicted && window > 0) {
+    // runtime/linuxcnc/smtcal_probe_predicted.ngc at the nominal pose: every
+    // trip in its window.
+    for (std::size_t p = 0; p < fixture.scan_paths.size(); ++p) {
+      const std::vector<PathTrip> trips = TripsOfPath(fixture, expected, p);
+      if (trips.empty()) continue;
+      Eigen::Vector2d here = Eigen::Vector2d::Zero();
+      std::size_t here_leg = 0;
+      double here_along = 0;
+      for (std::size_t i = 0; i < trips.size(); ++i) {
+        const PathTrip& trip = trips[i];
+        const double start = std::max(0.0, trip.along_mm - window);  // the window's start, on the leg
+        double to_edge = trip.along_mm - start;
+        if (i == 0) {
+          timing.travel_s += JumpSeconds(robot, fixture, known, at, trip.At(start));
+          ++timing.probe_moves;  // the descent: stops on an unexpected trip
+        } else if (here_leg == trip.leg && here_along >= start) {
+          to_edge = trip.along_mm - here_along;  // the window begins behind: latch on from here
+        } else if (const Eigen::Vector2d way = trip.At(start) - here;
+                   std::abs(way.x()) >= kShortestProbeMoveMm || std::abs(way.y()) >= kShortestProbeMoveMm) {
+          timing.search_s += MoveTime(way.norm(), robot.xy_speed_mm_s, a);
+          ++timing.probe_moves;
+        }
+        const ProbeMove latched = ProbeTo(to_edge, fixture.TripLatchSpeedMmS(), a, period);
+        timing.latch_s += latched.seconds;
+        ++timing.probe_moves;
+        here_leg = trip.leg;
+        here_along = trip.along_mm + latched.past_mm;
+        here = trip.At(here_along);
+      }
+      timing.travel_s += RiseSeconds(robot, fixture);
+      at = ScanPoint(here.x(), here.y(), robot.safe_limz_mm);
+      known = true;
+    }
+    return Finished(timing, robot, at);
+  }
+  const double search_speed = fixture.scan_speed_mm_s;
   for (std::size_t p = 0; p < fixture.scan_paths.size(); ++p) {
     const std::vector<cell::Point2>& points = fixture.scan_paths[p].points;
     const Eigen::Vector2d start = ToBase(nominal, points.front());
-    if (known) {
-      timing.travel_s += MoveTime(robot.safe_limz_mm - at.z(), robot.z_speed_mm_s, robot.z_accel_mm_s2);
-      timing.travel_s += MoveTime((start - at.head<2>()).norm(), robot.xy_speed_mm_s, a);
-    }
-    timing.travel_s += MoveTime(robot.safe_limz_mm - fixture.scan_z_mm, robot.z_speed_mm_s, robot.z_accel_mm_s2);
+    timing.travel_s += JumpSeconds(robot, fixture, known, at, start);
     for (std::size_t leg = 0; leg + 1 < points.size(); ++leg) {
       const double length = (points[leg + 1] - points[leg]).norm();
       double along = 0;  // where the robot stands on the leg
       for (const ExpectedTrip& trip : expected) {
         if (trip.path != p || trip.leg != leg) continue;
-        const ProbeMove find = ProbeTo(trip.along_mm - along, search, a, period);
+        const ProbeMove find = ProbeTo(trip.along_mm - along, search_speed, a, period);
         timing.search_s += find.seconds;
         ++timing.probe_moves;
         along = trip.along_mm + find.past_mm;
@@ -262,17 +351,36 @@ ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, cons
         }
       }
       // The rest of the leg: at the scan feed with one stage, a traverse with two.
-      timing.search_s += MoveTime(length - along, latch > 0 ? robot.xy_speed_mm_s : search, a);
+      timing.search_s += MoveTime(length - along, latch > 0 ? robot.xy_speed_mm_s : search_speed, a);
     }
-    timing.travel_s += MoveTime(robot.safe_limz_mm - fixture.scan_z_mm, robot.z_speed_mm_s, robot.z_accel_mm_s2);
+    timing.travel_s += RiseSeconds(robot, fixture);
     const Eigen::Vector2d end = ToBase(nominal, points.back());
     at = ScanPoint(end.x(), end.y(), robot.safe_limz_mm);
     known = true;
   }
-  timing.turnaround_s = timing.probe_moves * robot.probe_turnaround_s;
-  timing.seconds = timing.travel_s + timing.search_s + timing.latch_s + timing.turnaround_s;
-  timing.end = at;
-  return timing;
+  return Finished(timing, robot, at);
+}
+
+ScanTiming ScanFloor(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from) {
+  const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
+  const double a = robot.xy_accel_mm_s2, v = fixture.TripLatchSpeedMmS();
+  // A latch from rest that reaches the latch feed at the edge, and brakes.
+  const ProbeMove latch = ProbeTo(v * v / (2 * a), v, a, robot.servo_period_s);
+  ScanTiming floor;
+  bool known = from.has_value();
+  ScanPoint at = known ? *from : ScanPoint::Zero();
+  for (std::size_t p = 0; p < fixture.scan_paths.size(); ++p) {
+    const std::vector<PathTrip> trips = TripsOfPath(fixture, expected, p);
+    if (trips.empty()) continue;
+    floor.travel_s += JumpSeconds(robot, fixture, known, at, trips.front().At(trips.front().along_mm));
+    floor.travel_s += RiseSeconds(robot, fixture);
+    floor.latch_s += static_cast<double>(trips.size()) * latch.seconds;
+    floor.probe_moves += static_cast<int>(trips.size());
+    const Eigen::Vector2d last = trips.back().At(trips.back().along_mm);
+    at = ScanPoint(last.x(), last.y(), robot.safe_limz_mm);
+    known = true;
+  }
+  return Finished(floor, robot, at);  // search_s is 0
 }
 
 }  // namespace smtcal

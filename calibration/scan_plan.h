@@ -25,6 +25,22 @@
 // every probe move also costs the controller's probe_turnaround_s (the
 // interpreter waits for its result before it plans the next move). The
 // board is taken at its nominal pose.
+//
+// Predicted search (predicted_window_mm > 0): every scan after a fixture's
+// first knows where the last one found the board (its FIX); the runtime
+// latches each trip where that pose puts it, from predicted_window_mm before
+// the predicted crossing to as far past it, along the leg: per path a jump
+// to above the first trip's window and a descent to the scan z, then per
+// trip the latch at latch_speed_mm_s and a move straight to the next trip's
+// window start at the traverse speed, then up. Every move at the scan z is
+// a probe move (descent and moves between trips stop on an unexpected
+// change of the sensor). A trip not in its window, or a change where none
+// was expected, makes the runtime search that path in full (the fallback).
+//
+// The floor: what no scan of these paths can go below with this motion
+// model: the jumps (up, across to the next path's first trip, down) and per
+// trip one latch from rest that crosses the edge at the latch feed, with its
+// turnaround. It leaves out the moves between a path's trips.
 #pragma once
 
 #include <optional>
@@ -77,8 +93,19 @@ struct ScanTiming {
   ScanPoint end = ScanPoint::Zero();  // where the scan leaves the robot (the last path's end, at the safe z)
 };
 
+// How the runtime searches the trips of a scan.
+enum class ScanSearch {
+  kFull,       // along every leg from its start: a fixture's first scan, a fallback, no predicted_window_mm
+  kPredicted,  // every trip in its predicted window (the steady state); kFull without predicted_window_mm
+};
+
 // The scan's moves and their time, from `from` (unknown: the first path's
 // start is where the scan begins).
-ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from);
+ScanTiming ScanTime(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from,
+                    ScanSearch search = ScanSearch::kFull);
+
+// The scan's floor (above): travel_s the jumps, latch_s one latch per trip,
+// turnaround_s one turnaround per trip, search_s 0.
+ScanTiming ScanFloor(const cell::Robot& robot, const cell::Fixture& fixture, const std::optional<ScanPoint>& from);
 
 }  // namespace smtcal

@@ -1001,6 +1001,11 @@ std::optional<Fixture> Loader::ReadFixture(const toml::table& table, int index,
   fixture.sensor_input =
       WholeIn(keys, "sensor_input", limits::kIoBit, "the input bit the sensor is wired to").value_or(0);
   fixture.sensor_accuracy_mm = NumberIn(keys, "sensor_accuracy_mm", limits::kAccuracyMm).value_or(0);
+  // Without the key: 2 x the accuracy for the two scans' trips, 4 x for the
+  // board's change between cycles (docs/cell.md).
+  fixture.predicted_window_mm = NumberIn(keys, "predicted_window_mm", limits::kPredictedWindowMm, Need::kOptional)
+                                    .value_or(std::round(kDefaultPredictedWindowAccuracies * fixture.sensor_accuracy_mm *
+                                                         1e6) / 1e6);  // to the micrometre: 0.3, not 0.30000000000000004
   if (std::optional<int> estimator = Choice(keys, "estimator", kEstimatorNames)) {
     fixture.estimator = static_cast<Estimator>(*estimator);  // kEstimatorNames is in Estimator's order
   }

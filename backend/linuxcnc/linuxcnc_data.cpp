@@ -174,7 +174,7 @@ void AppendRegion(Layout& layout, const cell::Region& region, int directory_entr
   layout.Set(at + L::kRgDyAt, AppendTable(layout, n, TableAxis::Y, r.dy), n + ": Delta-y table at");
 }
 
-void AppendFixture(Layout& layout, const cell::Fixture& fixture, int directory_entry) {
+void AppendFixture(Layout& layout, const cell::Fixture& fixture, const cell::Robot& robot, int directory_entry) {
   const smtcal_fixture f = CRuntimeFixture(fixture);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const int trips = f.trip_count;
@@ -210,6 +210,10 @@ void AppendFixture(Layout& layout, const cell::Fixture& fixture, int directory_e
   layout.Set(at + L::kFxHasFix, 0, n + ": not scanned yet");
   layout.Set(at + L::kFxStatus, 0, n + ": last scan status");
   layout.Set(at + L::kFxRecordCycles, 0, n + ": scans recorded since the start");
+  layout.Set(at + L::kFxPredictedWindow, fixture.predicted_window_mm, n + ": predicted_window_mm; 0: every scan in full");
+  layout.Set(at + L::kFxPredictedPaths, 0, n + ": the last scan's paths latched where predicted");
+  layout.Set(at + L::kFxFallbackPaths, 0, n + ": the last scan's paths searched in full after a prediction failed");
+  layout.Set(at + L::kFxTraverseFeed, robot.xy_speed_mm_s * 60, n + ": traverse feed mm/min between predicted trips");
 
   const int edges_at = layout.Reserve(trips);
   layout.Set(at + L::kFxTripEdgeAt, edges_at, n + ": trip edges at");
@@ -308,7 +312,7 @@ std::string DataText(const cell::Cell& cell, std::optional<long> id) {
     AppendRegion(layout, cell.regions[r], region_directory + static_cast<int>(r));
   }
   for (std::size_t k = 0; k < cell.fixtures.size(); ++k) {
-    AppendFixture(layout, cell.fixtures[k], fixture_directory + static_cast<int>(k));
+    AppendFixture(layout, cell.fixtures[k], cell.robot, fixture_directory + static_cast<int>(k));
   }
   SMTCAL_CHECK(layout.next() == TotalSize(cell), "the LinuxCNC data layout and its size disagree");
 

@@ -42,6 +42,12 @@ inline constexpr int kFxEstimator = 0, kFxOriginX = 1, kFxOriginY = 2, kFxCos = 
                      kFxScanPathsAt = 33, kFxHasFix = 34, kFxFix = 35, kFxStatus = 41, kFxFailedTrip = 42,
                      kFxCheckValue = 43 /* + code 1..11 */, kFxCheckEvaluated = 55 /* + code */, kFxS = 67,
                      kFxScale = 73, kFxLatchFeed = 74, kFxRecordCycles = 75, kFxRecordSize = 80;
+// Predicted search (runtime/linuxcnc/smtcal_probe_predicted.ngc): the
+// fixture's predicted_window_mm (0: none) and the traverse feed (mm/min)
+// between trips, data; the last scan's paths latched where predicted and
+// those searched in full after a prediction failed, set by each scan.
+inline constexpr int kFxPredictedWindow = 76, kFxPredictedPaths = 77, kFxFallbackPaths = 78,
+                     kFxTraverseFeed = 79;
 // The cycle record (backend/linuxcnc/linuxcnc_record.h): the line buffer the
 // LOG comments print, above the estimators' scratch (#4700..#4963); and the
 // counters that bound the log files, kept across runs in the machine's

@@ -132,6 +132,10 @@ json CompileReportJson(const ir::Program& program, const CompileState& state, co
                           {"placements", cycle.placements},
                           {"motion_s", RoundedJson(cycle.motion_s, kSecondsDecimals)},
                           {"scan_s", RoundedJson(cycle.scan_s, kSecondsDecimals)},
+                          {"first_scan_s", RoundedJson(cycle.first_scan_s, kSecondsDecimals)},
+                          {"scan_floor_s", RoundedJson(cycle.scan_floor_s, kSecondsDecimals)},
+                          {"scan_floor_ratio",
+                           RoundedJson(cycle.scan_floor_s > 0 ? cycle.scan_s / cycle.scan_floor_s : 0.0, 2)},
                           {"total_s", RoundedJson(total, kSecondsDecimals)},
                           {"scan_share", RoundedJson(total > 0 ? cycle.scan_s / total : 0.0, kShareDecimals)}});
   }
@@ -230,9 +234,18 @@ std::string VerifySummaryText(const ir::Program& program, const CompileState& st
   }
   for (const CycleEstimate& cycle : state.cycles) {
     double total = cycle.total_s();
-    text += fmt::format("  cycle {} at {}: {} placements, about {:.1f} s, of which the scan {:.1f} s ({:.1f} %)\n",
+    text += fmt::format("  cycle {} at {}: {} placements, about {:.1f} s, of which the scan {:.1f} s ({:.1f} %)",
                         cycle.fixture, LocationText(sources, cycle.cycle->loc), cycle.placements, total, cycle.scan_s,
                         total > 0 ? 100.0 * cycle.scan_s / total : 0.0);
+    if (cycle.scan_floor_s > 0) {
+      text += cycle.first_scan_s > cycle.scan_s
+                  ? fmt::format(" predicted from the last scan (the first cycle's, searched in full, {:.1f} s)",
+                                cycle.first_scan_s)
+                  : std::string();
+      text += fmt::format("; the scan's floor {:.1f} s, {:.2f} x it (docs/periphery.md)", cycle.scan_floor_s,
+                          cycle.scan_s / cycle.scan_floor_s);
+    }
+    text += "\n";
   }
   if (!state.trace_complete) text += "  the compile-time run stopped early: later targets were not verified\n";
   text += counts.errors == 0

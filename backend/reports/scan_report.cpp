@@ -330,6 +330,8 @@ ScanReport MakeScanReport(const cell::Cell& cell, const cell::Fixture& fixture, 
   report.cell_name = cell.name;
   report.fixture = &fixture;
   report.timing = ScanTime(cell.robot, fixture, from);
+  report.predicted = ScanTime(cell.robot, fixture, from, ScanSearch::kPredicted);
+  report.floor = ScanFloor(cell.robot, fixture, from);
   report.timed_from_program = from.has_value();
   report.capture = ScanCaptureRange(fixture);
   report.latency_mm = fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s;
@@ -396,6 +398,23 @@ std::string ScanReportText(const ScanReport& report) {
                      report.timed_from_program ? "from where the program's cycle ends" : "from the first path's start",
                      Fixed(t.travel_s, 2), Fixed(t.search_s, 2), Fixed(t.latch_s, 2), t.probe_moves,
                      Fixed(t.probe_moves > 0 ? t.turnaround_s / t.probe_moves : 0, 3));
+  const ScanTiming& f = report.floor;
+  if (fixture.predicted_window_mm > 0) {
+    const ScanTiming& p = report.predicted;
+    out += fmt::format("  every cycle after the first, each trip latched within +-{} mm of where the last scan puts "
+                       "it: {} s (jumps {} s, moves between trips {} s, latches {} s, {} probe moves); a path whose "
+                       "trip is not there is searched in full\n",
+                       Num(fixture.predicted_window_mm), Fixed(p.seconds, 2), Fixed(p.travel_s, 2),
+                       Fixed(p.search_s, 2), Fixed(p.latch_s, 2), p.probe_moves);
+  }
+  out += fmt::format("  floor: {} s (jumps {} s, one latch a trip {} s, {} turnarounds), the moves between a path's "
+                     "trips left out; the scan is {} x it{}\n",
+                     Fixed(f.seconds, 2), Fixed(f.travel_s, 2), Fixed(f.latch_s, 2), f.probe_moves,
+                     Fixed(f.seconds > 0 ? t.seconds / f.seconds : 0, 2),
+                     fixture.predicted_window_mm > 0
+                         ? fmt::format(" in full, {} x predicted",
+                                       Fixed(f.seconds > 0 ? report.predicted.seconds / f.seconds : 0, 2))
+                         : std::string());
   const CaptureRange& c = report.capture;
   out += fmt::format("capture range: boards within {} mm and {} deg of nominal, {} x the limits ({} mm, {} deg){}\n",
                      Fixed(c.shift_mm, 2), Fixed(c.rotation_deg, 3), Fixed(c.factor, 2), Num(fixture.max_shift_mm),
@@ -491,6 +510,16 @@ std::string ScanReportJson(const ScanReport& report) {
                  {"travel_s", s4(t.travel_s)}, {"search_s", s4(t.search_s)},
                  {"latch_s", s4(t.latch_s)},   {"turnaround_s", s4(t.turnaround_s)},
                  {"probe_moves", t.probe_moves}};
+  const ScanTiming& p = report.predicted;
+  out["time"]["predicted"] = {{"window_mm", fixture.predicted_window_mm}, {"seconds", s4(p.seconds)},
+                              {"travel_s", s4(p.travel_s)},              {"between_trips_s", s4(p.search_s)},
+                              {"latch_s", s4(p.latch_s)},                {"turnaround_s", s4(p.turnaround_s)},
+                              {"probe_moves", p.probe_moves}};
+  const ScanTiming& f = report.floor;
+  out["time"]["floor"] = {{"seconds", s4(f.seconds)},     {"travel_s", s4(f.travel_s)},
+                          {"latch_s", s4(f.latch_s)},     {"turnaround_s", s4(f.turnaround_s)},
+                          {"ratio_full", RoundedToDecimals(f.seconds > 0 ? t.seconds / f.seconds : 0, 3)},
+                          {"ratio_predicted", RoundedToDecimals(f.seconds > 0 ? p.seconds / f.seconds : 0, 3)}};
   out["capture"] = {{"factor", s4(report.capture.factor)},
                     {"shift_mm", s4(report.capture.shift_mm)},
                     {"rotation_deg", RoundedToDecimals(report.capture.rotation_deg, 5)},

@@ -57,7 +57,9 @@ struct ScanSuggestion {
 struct ScanReport {
   std::string cell_name;
   const cell::Fixture* fixture = nullptr;
-  ScanTiming timing;
+  ScanTiming timing;                // every leg searched in full: the first cycle's scan, and a fallback's
+  ScanTiming predicted;             // every trip where the last scan predicts it (= timing without prediction)
+  ScanTiming floor;                 // what no scan of these paths goes below (ScanFloor)
   bool timed_from_program = false;  // the scan starts where the program's cycle ends
   CaptureRange capture;
   double latency_mm = 0;            // how far past its edge a trip can be latched

@@ -131,7 +131,10 @@ struct CycleEstimate {
   const ir::Stmt* cycle = nullptr;
   std::string fixture;
   double motion_s = 0;  // moves, picks, places and waits
-  double scan_s = 0;    // the marker scan prologue
+  double scan_s = 0;    // the marker scan prologue, as every cycle after the first runs it (predicted, when the
+                        // fixture has predicted_window_mm: calibration/scan_plan.h)
+  double first_scan_s = 0;  // the first cycle's scan, and a fallback's: every leg searched in full
+  double scan_floor_s = 0;  // what no scan of these paths goes below (ScanFloor)
   int placements = 0;
   double total_s() const { return motion_s + scan_s; }
 };

@@ -273,13 +273,18 @@ class VerifyTargets final : public Pass {
   }
 
   // The marker scan as the runtime drives it (calibration/scan_plan.h), from
-  // where the robot stands; it leaves the robot above the last path's end.
-  static double ScanTime(const cell::Robot& robot, const FixtureBinding& binding, Position& at) {
+  // where the robot stands: in the steady state (predicted, when the fixture
+  // predicts), the first cycle's (in full) and the floor; it leaves the robot
+  // where the steady state's ends.
+  static void ScanTimes(const cell::Robot& robot, const FixtureBinding& binding, Position& at,
+                        CycleEstimate& estimate) {
     std::optional<ScanPoint> from;
     if (at.known) from = ScanPoint(at.pose[0], at.pose[1], at.pose[2]);
-    const ScanTiming timing = smtcal::ScanTime(robot, *binding.cell_fixture, from);
-    at = {{timing.end.x(), timing.end.y(), timing.end.z(), at.known ? at.pose[3] : 0.0}, true};
-    return timing.seconds;
+    const ScanTiming steady = smtcal::ScanTime(robot, *binding.cell_fixture, from, ScanSearch::kPredicted);
+    estimate.scan_s = steady.seconds;
+    estimate.first_scan_s = smtcal::ScanTime(robot, *binding.cell_fixture, from, ScanSearch::kFull).seconds;
+    estimate.scan_floor_s = ScanFloor(robot, *binding.cell_fixture, from).seconds;
+    at = {{steady.end.x(), steady.end.y(), steady.end.z(), at.known ? at.pose[3] : 0.0}, true};
   }
 
   // Where the robot is commanded for a target (base frame; a fixture
@@ -310,7 +315,7 @@ class VerifyTargets final : public Pass {
       estimate.fixture = cycle.fixture;
       Position at = CycleEnd(state, events);
       int fixture = state.FindFixture(cycle.fixture);
-      if (fixture >= 0) estimate.scan_s = ScanTime(robot, state.fixtures[fixture], at);
+      if (fixture >= 0) ScanTimes(robot, state.fixtures[fixture], at, estimate);
       for (const TraceEvent& event : events) {
         if (event.kind == TraceEvent::Kind::kWait) {
           estimate.motion_s += event.wait_s;

@@ -87,6 +87,7 @@ def limit_corner(turn_deg, towards_deg, fraction=0.99):
 MARKER2_DRIFT_DEG = math.degrees(math.atan2(190.0, -90.0))
 
 SIM = os.path.join(HERE, "sim.place")
+MONITOR = os.path.join(HERE, "monitor.place")
 EXAMPLE_PROGRAM = os.path.join(SOURCE, "examples", "paper-cell", "layers.place")
 V_PATHS = os.path.join(HERE, "v-paths-fixture.toml")  # the scan before two stages: V paths at 12 mm/s
 
@@ -95,8 +96,11 @@ V_PATHS = os.path.join(HERE, "v-paths-fixture.toml")  # the scan before two stag
 # (`smtcal cell check` states the capture range): boards at the corners of
 # the limits place, boards beyond them are refused by the pose checks.
 SCENARIOS = {
+    # The first board anywhere; the next two within 0.1 mm and 0.03 deg of
+    # it, as a fixture repeats: their scans are latched where the last one
+    # predicts (predicted_window_mm).
     "good_boards": {"program": SIM, "expect": "ok",
-                    "cycles": [pose(0.3, -0.2, 0.1), pose(-0.6, 0.45, -0.2), pose(-0.2, 0.4, 0.25)]},
+                    "cycles": [pose(0.3, -0.2, 0.1), pose(0.36, -0.16, 0.12), pose(0.27, -0.25, 0.09)]},
     # The corners of the limits: S1 1.98 mm off, turned 0.495 deg; the first
     # two move marker 2 the most (3.8 mm). A nominal board between two
     # corners: the cycle checks hold the change between two boards to the
@@ -108,8 +112,10 @@ SCENARIOS = {
     "missing_board": {"program": SIM, "expect": "missing_trip", "cycles": [pose(present=False)]},
     "shifted_board": {"program": SIM, "expect": "nominal_shift", "cycles": [pose_s1(1.45, 1.45)]},
     "rotated_board": {"program": SIM, "expect": "nominal_rotation", "cycles": [pose_s1(turn_deg=-0.515)]},
-    "cycle_shift": {"program": SIM, "expect": "cycle_shift", "cycles": [pose_s1(-1.0, 0.6), pose_s1(1.0, -0.6)]},
-    "cycle_rotation": {"program": SIM, "expect": "cycle_rotation",
+    # The cycle checks: monitor.place (one part a cycle) is enough for the
+    # first board.
+    "cycle_shift": {"program": MONITOR, "expect": "cycle_shift", "cycles": [pose_s1(-1.0, 0.6), pose_s1(1.0, -0.6)]},
+    "cycle_rotation": {"program": MONITOR, "expect": "cycle_rotation",
                        "cycles": [pose(turn_deg=-0.3), pose(turn_deg=0.25)]},
     # The dry-run probe file (compile --dry-run-probe) first on the machine's
     # path by mistake: it must abort before the first move.
@@ -121,22 +127,25 @@ SCENARIOS = {
     # Opt-in: the scan before two stages (V paths, every trip latched at 12
     # mm/s) and the example's, on the same boards (within the V paths' narrow
     # capture), side by side: the overhead per cycle and the pose's error.
+    # Every scan in full (predicted_window_mm 0), as the designs compared.
     "scan_compare": {"program": SIM, "expect": "ok",
                      "cycles": [pose(0.3, -0.2, 0.1), pose(-0.3, 0.2, -0.15), pose(0.1, 0.3, 0.05),
                                 pose(-0.2, -0.3, 0.2)],
-                     "variants": [{"name": "v-paths-12", "fixture": V_PATHS,
+                     "variants": [{"name": "v-paths-12", "fixture": V_PATHS, "cell": {"predicted_window_mm": 0},
                                    "what": "today's scan: V paths, one stage at 12 mm/s"},
-                                  {"name": "hairpins-40-8", "what": "the example: two stages, 40 and 8 mm/s"}]},
+                                  {"name": "hairpins-40-8", "cell": {"predicted_window_mm": 0},
+                                   "what": "the example: two stages, 40 and 8 mm/s"}]},
     # Opt-in: the frontier of time against accuracy: the example's paths at
-    # other search and latch speeds.
+    # other search and latch speeds, every scan in full.
     "scan_frontier": {"program": SIM, "expect": "ok",
                       "cycles": [pose(0.3, -0.2, 0.1), pose(-0.3, 0.2, -0.15), pose(0.1, 0.3, 0.05),
                                  pose(-0.2, -0.3, 0.2)],
                       "variants": [{"name": f"two-stages-{search}-{latch}", "what": f"search {search}, latch {latch} mm/s",
-                                    "cell": {"scan_speed_mm_s": search, "latch_speed_mm_s": latch}}
+                                    "cell": {"scan_speed_mm_s": search, "latch_speed_mm_s": latch,
+                                             "predicted_window_mm": 0}}
                                    for search, latch in ((25, 4), (40, 4), (40, 8), (40, 12), (60, 8), (100, 12))]
                       + [{"name": "one-stage-12", "what": "one stage at 12 mm/s",
-                          "cell": {"scan_speed_mm_s": 12, "latch_speed_mm_s": None}}]},
+                          "cell": {"scan_speed_mm_s": 12, "latch_speed_mm_s": None, "predicted_window_mm": 0}}]},
 }
 # The monitor (docs/monitor.md): a board that walks and a robot whose scale
 # between the markers drifts (the sensor HAL's gains; the checker lands the
@@ -145,7 +154,6 @@ SCENARIOS = {
 # come before the cycle at which the drifting scale would put parts at the
 # board's far corner out of tolerance. The short one runs with every ctest;
 # the long one is opt-in.
-MONITOR = os.path.join(HERE, "monitor.place")
 
 
 def drifting(cycles, start, walk_mm, scale_ppm, seed=30):
@@ -176,6 +184,22 @@ SCENARIOS["monitor_drift_long"] = {"program": MONITOR, "expect": "ok", "cell_add
 SCENARIOS["record_overhead"] = {"program": SIM, "expect": "overhead", "cell_add": MONITOR_CELL, "cycles": [],
                                 "overhead_calls": 200}
 
+# Boards that repeat within 0.05 mm and 0.02 deg of (0.2, -0.1, 0.05), as a
+# fixture repeats: every scan after the first is latched where the last
+# one predicts.
+def repeating_boards(count, seed):
+    rng = random.Random(seed)
+    return [pose(0.2 + rng.uniform(-0.05, 0.05), -0.1 + rng.uniform(-0.05, 0.05), 0.05 + rng.uniform(-0.02, 0.02))
+            for _ in range(count)]
+
+
+# Opt-in: the steady state: eight boards that repeat within 0.05 mm and
+# 0.02 deg, scanned in full (no predicted_window_mm) and predicted, side by
+# side: the overhead per cycle and the pose's error.
+SCENARIOS["scan_predicted"] = {"program": SIM, "expect": "ok", "cycles": repeating_boards(8, 46),
+                               "variants": [{"name": "in-full", "what": "every scan in full",
+                                             "cell": {"predicted_window_mm": 0}},
+                                            {"name": "predicted", "what": "the example: predicted, 0.3 mm"}]}
 # Opt-in: the trip latency against the speed of one-stage probing (one good board each).
 for speed in (6, 12, 25, 50, 100):
     SCENARIOS[f"latency_{speed}mm_s"] = {"program": SIM, "expect": "ok",
@@ -537,6 +561,29 @@ def scan_path_points(cell_text, fixture="Board"):
                            for x, y in path["points_mm"]] for path in board["scan_path"]}
 
 
+def trips_from_record(probes, record_trips, observer=""):
+    """The trips a scan latched, by index, as the driver saw them: each trip
+    the runtime's cycle record names is a probe move's result (the record
+    keeps #5061/#5062 to 1e-10 mm, the driver stat.probed_position), the
+    trips in the order of the probe moves. For a scan latched where the last
+    one predicts (smtcal_probe_predicted.ngc), whose moves between trips and
+    whose fallback to the full search make no fixed pattern."""
+    trips = {}
+    at = 0
+    for k, trip in enumerate(record_trips):
+        if trip[4:] == ["-", "-"]:
+            continue
+        x, y = float(trip[4]), float(trip[5])
+        j = next((i for i in range(at, len(probes))
+                  if abs(probes[i]["x"] - x) < 1e-9 and abs(probes[i]["y"] - y) < 1e-9), None)
+        if j is None:
+            fail(f"the record's T{k + 1} ({x}, {y}) is none of the probe results the driver saw after the "
+                 f"previous trip's{observer}")
+        trips[k] = probes[j]
+        at = j + 1
+    return trips
+
+
 def trips_of_cycle(probes, paths, two_stage, path_points, observer=""):
     """The trips the runtime latched, by index: its probe moves in order, per
     path until the first move that did not trip (smtcal_probe_trips.ngc).
@@ -636,7 +683,7 @@ def cell_copy(work, scenario):
             text, n = re.subn(rf"(?m)^{key} = .*\n", "", text)
         else:
             text, n = re.subn(rf"(?m)^{key} = \S+", f"{key} = {value}", text)
-        if n == 0 and key == "latch_speed_mm_s" and value is not None:  # a fixture key the cell may lack
+        if n == 0 and key in ("latch_speed_mm_s", "predicted_window_mm") and value is not None:  # keys the cell may lack
             text, n = re.subn(r"(?m)^(scan_speed_mm_s = .*)$", rf"\1\n{key} = {value}", text)
         if n != 1:
             fail(f"cannot set {key} in a copy of the cell file")
@@ -693,9 +740,26 @@ def main():
 
 def verify_scan_seconds(args, program, cell):
     """verify's estimate of the scan's time in the program's cycle."""
+    return verify_scan(args, program, cell).get("scan_s", float("nan"))
+
+
+def verify_scan(args, program, cell):
+    """verify's figures of the scan in the program's cycle: scan_s (every
+    cycle after the first), first_scan_s, scan_floor_s."""
     report = smtcal(["verify", program, "--cell", cell, "--json"], args.smtcal)
     cycles = json.loads(report.stdout).get("cycles", []) if report.stdout else []
-    return cycles[0]["scan_s"] if cycles and "scan_s" in cycles[0] else float("nan")
+    return cycles[0] if cycles else {}
+
+
+def predicted_probe_moves(args, cell):
+    """The probe moves of a scan latched where the last one predicts, every
+    trip in its window (`smtcal scan report`'s model of the runtime), or
+    None when the fixture predicts nothing (predicted_window_mm 0)."""
+    report = smtcal(["scan", "report", "--cell", cell, "--json"], args.smtcal)
+    if report.returncode != 0:
+        fail("smtcal scan report: " + report.stderr)
+    predicted = json.loads(report.stdout)["time"]["predicted"]
+    return predicted["probe_moves"] if predicted["window_mm"] > 0 else None
 
 
 def run_machine(args, scenario, work):
@@ -750,6 +814,8 @@ def run_machine(args, scenario, work):
     two_stage = re.search(r"(?m)^latch_speed_mm_s = ", cell_text) is not None
     scan_z = float(re.search(r"(?m)^scan_z_mm = (\S+)", cell_text).group(1))
     path_points = scan_path_points(cell_text)
+    predicted_moves = predicted_probe_moves(args, cell)
+    records = read_record_log(os.path.join(work, RECORD_FILE))[1] if predicted_moves else []
     measured = []
     previous = None
     verdicts = []
@@ -759,7 +825,16 @@ def run_machine(args, scenario, work):
         gap_ms = cycle.get("poll_gap_max_s", float("nan")) * 1000
         observer = (f" (the driver's longest gap between two status polls in this cycle {gap_ms:.1f} ms: a probe "
                     f"result can show for as little as 15 ms)")
-        trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points, observer)
+        # Every scan after the first accepted one is latched where that one
+        # predicts (the cell's predicted_window_mm): its trips are the
+        # record's, found among the probe results.
+        predicted = predicted_moves is not None and n > 0
+        if predicted:
+            if n >= len(records):
+                fail(f"cycle {n + 1}: the runtime recorded {len(records)} scans")
+            trips = trips_from_record(cycle["probes"], records[n]["trips"], observer)
+        else:
+            trips = trips_of_cycle(cycle["probes"], paths, two_stage, path_points, observer)
         trips_csv = os.path.join(work, f"cycle{n + 1}-trips.csv")
         write_trips(trips_csv, trips)
         scan_json = os.path.join(work, f"cycle{n + 1}-scan.json")
@@ -777,9 +852,14 @@ def run_machine(args, scenario, work):
         overhead = scan_overhead(cycle, scan_z)
         if verdict["ok"]:
             error = pose_error(verdict, cycle["pose"])
+            moves = len(cycle["probes"])
+            search = ("searched in full" if not predicted else "latched where the last scan predicts"
+                      if moves == predicted_moves else "a path searched in full after its prediction failed")
             log(f"  cycle {n + 1}: scan overhead {overhead if overhead is None else round(overhead, 3)} s, "
-                f"board pose error {error:.4f} mm, driver's longest poll gap {gap_ms:.1f} ms")
-            measured.append({"overhead_s": overhead, "pose_error_mm": error})
+                f"board pose error {error:.4f} mm, {moves} probe moves ({search}), driver's longest poll gap "
+                f"{gap_ms:.1f} ms")
+            measured.append({"overhead_s": overhead, "pose_error_mm": error, "probe_moves": moves,
+                             "predicted": predicted and moves == predicted_moves})
         places = [e for e in record["vacuum"] if e["cycle"] == n and not e["on"]]
         check_cycles.append({"pose": cycle["pose"], "trips": {str(k): [p["x"], p["y"]] for k, p in trips.items()},
                              "scan": scan_json, "places": [e["position"] + [e["velocity"]] for e in places],
@@ -813,7 +893,24 @@ def run_machine(args, scenario, work):
     check_record_log(os.path.join(work, RECORD_FILE), latched, verdicts, "monitor" in scenario)
     if "monitor" in scenario:
         check_monitor(args, scenario, cell, os.path.join(work, RECORD_FILE))
-    return {"cycles": measured, "verify_scan_s": verify_scan_seconds(args, scenario["program"], cell)}
+    verify = verify_scan(args, scenario["program"], cell)
+    report_steady_state(measured, verify)
+    return {"cycles": measured, "verify_scan_s": verify.get("scan_s", float("nan")), "verify": verify}
+
+
+def report_steady_state(measured, verify):
+    """The scans latched where predicted against those searched in full and
+    against the floor verify states for the program's cycle."""
+    floor = verify.get("scan_floor_s")
+    for kind, rows in (("latched where predicted", [m for m in measured if m.get("predicted")]),
+                       ("searched in full", [m for m in measured if not m.get("predicted")])):
+        overheads = [m["overhead_s"] for m in rows if m["overhead_s"] is not None]
+        if not overheads:
+            continue
+        mean = sum(overheads) / len(overheads)
+        ratio = f", {mean / floor:.2f} x the floor of {floor:.3f} s (verify)" if floor else ""
+        log(f"  {kind}: {len(overheads)} scan(s), overhead mean {mean:.3f} s, max {max(overheads):.3f} s{ratio}; "
+            f"pose error max {max(m['pose_error_mm'] for m in rows):.4f} mm")
 
 
 # ------------------------------------------------------------------ the cycle record

@@ -111,8 +111,8 @@ TEST(ScanPlan, PosesWithinTheCaptureRangeScanCleanly) {
   }
 }
 
-// One straight path across one edge: the moves by hand.
-TEST(ScanPlan, TimeFollowsTheRuntimesMoves) {
+// The robot the scan's times are checked with, by hand.
+cell::Robot TimedRobot(double probe_turnaround_s) {
   cell::Robot robot;
   robot.xy_speed_mm_s = 800;
   robot.xy_accel_mm_s2 = 3000;
@@ -120,7 +120,13 @@ TEST(ScanPlan, TimeFollowsTheRuntimesMoves) {
   robot.z_accel_mm_s2 = 2000;
   robot.safe_limz_mm = 0;
   robot.servo_period_s = 0.001;
-  robot.probe_turnaround_s = 0.004;
+  robot.probe_turnaround_s = probe_turnaround_s;
+  return robot;
+}
+
+// One straight path across one edge: the moves by hand.
+TEST(ScanPlan, TimeFollowsTheRuntimesMoves) {
+  const cell::Robot robot = TimedRobot(0.004);
   cell::Fixture fixture = HairpinFixture();
   fixture.scan_z_mm = -2;
   const ScanTiming two = ScanTime(robot, fixture, std::nullopt);
@@ -155,6 +161,49 @@ TEST(ScanPlan, TimeFollowsTheRuntimesMoves) {
               MoveTime(3, 300, 2000) + MoveTime((Eigen::Vector2d(138 + 194.1, 40 + 85.9) -
                                                  Eigen::Vector2d(300, 130)).norm(), 800, 3000),
               1e-12);
+}
+
+// The predicted scan (every trip in its window) and the floor, against the
+// full scan and by hand.
+TEST(ScanPlan, PredictedScanAndFloor) {
+  const cell::Robot robot = TimedRobot(0.025);
+  cell::Fixture fixture = HairpinFixture();
+  fixture.scan_z_mm = -2;
+  const ScanPoint from(300, 130, -3);
+  const ScanTiming full = ScanTime(robot, fixture, from);
+  // Without a window every scan is searched in full.
+  const ScanTiming none = ScanTime(robot, fixture, from, ScanSearch::kPredicted);
+  EXPECT_EQ(none.seconds, full.seconds);
+  EXPECT_EQ(none.probe_moves, full.probe_moves);
+  fixture.predicted_window_mm = 0.3;
+  const ScanTiming predicted = ScanTime(robot, fixture, from, ScanSearch::kPredicted);
+  // Per path: the descent, four latches, three moves between them (the
+  // hairpin's turn outside the marker is 0.36 mm, more than LinuxCNC's
+  // shortest probe move).
+  EXPECT_EQ(predicted.probe_moves, 2 * (1 + 4 + 3));
+  EXPECT_NEAR(predicted.turnaround_s, 16 * 0.025, 1e-12);
+  EXPECT_LT(predicted.seconds, full.seconds - 1);
+  EXPECT_NEAR(predicted.seconds,
+              predicted.travel_s + predicted.search_s + predicted.latch_s + predicted.turnaround_s, 1e-12);
+  // A latch from 0.3 mm before the edge at 8 mm/s: accelerate (8/3000 s over
+  // 0.0107 mm), cruise, half a servo period late, brake.
+  const double latch = 8.0 / 3000 + (0.3 - 64.0 / 6000) / 8 + 0.0005 + 8.0 / 3000;
+  EXPECT_NEAR(predicted.latch_s, 8 * latch, 1e-9);
+  // The floor: the same jumps to the trips themselves, one latch from rest
+  // reaching 8 mm/s at the edge, a turnaround per trip.
+  const ScanTiming floor = ScanFloor(robot, fixture, from);
+  EXPECT_EQ(floor.probe_moves, 8);
+  EXPECT_EQ(floor.search_s, 0);
+  EXPECT_NEAR(floor.latch_s, 8 * (2 * 8.0 / 3000 + 0.0005), 1e-12);
+  EXPECT_NEAR(floor.turnaround_s, 8 * 0.025, 1e-12);
+  const double z = MoveTime(2, 300, 2000);
+  const Eigen::Vector2d t1(138 + 190, 40 + 85.9), t4(138 + 190, 40 + 86.1), t5(138 + 0, 40 + 3.9);
+  EXPECT_NEAR(floor.travel_s,
+              MoveTime(3, 300, 2000) + MoveTime((t1 - Eigen::Vector2d(300, 130)).norm(), 800, 3000) + 3 * z +
+                  MoveTime((t5 - t4).norm(), 800, 3000) + z,
+              1e-12);
+  EXPECT_LT(floor.seconds, predicted.seconds);
+  EXPECT_LT(predicted.seconds, full.seconds);
 }
 
 }  // namespace
