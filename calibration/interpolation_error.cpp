@@ -76,10 +76,53 @@ double DeclaredFigure(const DeclaredRoughness& roughness, double amplitude_mm, d
   return amplitude_mm * (1 - std::cos(phase));
 }
 
+// The standard error of a point's mean: the pooled reading scatter over the
+// square root of its count; a point that states no count is one reading (of
+// the pooled scatter, else `unknown_noise_mm`).
+double PointNoiseMm(int count, const std::optional<double>& pooled, double unknown_noise_mm) {
+  if (!pooled) return unknown_noise_mm;
+  return count > 0 ? *pooled / std::sqrt(static_cast<double>(count)) : *pooled;
+}
+
+// The noise of the bilinear interpolation at a point from its cell's nodes.
+double InterpolationNoiseMm(const AxisTable& t, const CellPlace& p, const std::optional<double>& pooled,
+                            double unknown_noise_mm) {
+  double variance = 0;
+  for (std::size_t b = 0; b < 2; ++b) {
+    for (std::size_t a = 0; a < 2; ++a) {
+      const double weight = (a == 1 ? p.s : 1 - p.s) * (b == 1 ? p.t : 1 - p.t);
+      const std::size_t k = t.Index(p.i + a, p.j + b);
+      const double se = PointNoiseMm(k < t.count.size() ? t.count[k] : 0, pooled, unknown_noise_mm);
+      variance += weight * weight * se * se;
+    }
+  }
+  return std::sqrt(variance);
+}
+
+// A check point within this of its cell's centre along both axes (p and q at
+// least this) tells the centre's departure A + B.
+constexpr double kCentreShare = 0.99;
+
+// The quadratic model's largest departure in a cell, max(|A|, |B|, |A + B|),
+// given a check point's residual r at shares p = 4 s(1-s), q = 4 t(1-t) and
+// the curvature figures |A| <= cx, |B| <= cy (docs: "Between the nodes").
+double CheckFigure(double residual, double p, double q, double cx, double cy) {
+  const double phi = std::max(0.5 * (p + q), kMinCheckPointShare);
+  const double centre = std::abs(residual) / phi;
+  if (p >= kCentreShare && q >= kCentreShare && centre <= cx + cy) {
+    return std::max({centre, std::min(cx, centre + cy), std::min(cy, centre + cx)});
+  }
+  return std::max(centre, cx + cy);
+}
+
 AxisInterpolation EstimateAxis(const AxisTable& t, const std::optional<DeclaredRoughness>& roughness,
                                double unknown_noise_mm) {
   AxisInterpolation result;
   const std::size_t nx = t.nx(), ny = t.ny();
+  result.xs = t.xs;
+  result.ys = t.ys;
+  result.reading_scatter_mm = PooledReadingScatterMm(t);
+  const std::optional<double>& pooled = result.reading_scatter_mm;
   // Second derivatives at interior nodes: along x per row, along y per column.
   std::vector<std::vector<double>> fxx(ny, std::vector<double>(nx, 0.0));
   std::vector<std::vector<double>> fyy(nx, std::vector<double>(ny, 0.0));
@@ -106,27 +149,59 @@ AxisInterpolation EstimateAxis(const AxisTable& t, const std::optional<DeclaredR
   }
   const double hidden =
       roughness ? HiddenAmplitude(*roughness, largest_second, largest_pitch, {nx, ny}) : 0.0;
-  // The check-point figure of each cell.
-  std::vector<std::optional<double>> checked((nx - 1) * (ny - 1));
-  std::vector<const TableNode*> checked_by((nx - 1) * (ny - 1));
+  // Each cell's curvature figures along x and y.
+  const std::size_t cells = (nx - 1) * (ny - 1);
+  std::vector<double> cx(cells), cy(cells);
+  for (std::size_t j = 0; j + 1 < ny; ++j) {
+    for (std::size_t i = 0; i + 1 < nx; ++i) {
+      const double hx = t.xs[i + 1] - t.xs[i], hy = t.ys[j + 1] - t.ys[j];
+      double cxx = 0, cyy = 0;
+      for (std::size_t row : {j, j + 1}) cxx = std::max(cxx, CurvatureAlong(t.xs, i, fxx[row]));
+      for (std::size_t column : {i, i + 1}) cyy = std::max(cyy, CurvatureAlong(t.ys, j, fyy[column]));
+      cx[j * (nx - 1) + i] = hx * hx / 8 * cxx;
+      cy[j * (nx - 1) + i] = hy * hy / 8 * cyy;
+    }
+  }
+  // Each check point's residual, its noise (at the cell's centre) and its
+  // quadratic-model figure.
+  struct Check {
+    const TableNode* node;
+    std::size_t cell;
+    double residual, noise, figure;
+  };
+  std::vector<Check> seen;
   for (const TableNode& check : t.checks) {
     const CellPlace place = PlaceInCell(t, check.x_mm, check.y_mm);
+    const std::size_t c = place.j * (nx - 1) + place.i;
     const double residual = check.error_mm - Interpolate(t, check.x_mm, check.y_mm);
-    double own = unknown_noise_mm;
-    if (check.stddev_mm && check.count > 0) own = *check.stddev_mm / std::sqrt(static_cast<double>(check.count));
-    const double noise = std::hypot(own, InterpolatedNoiseMm(t, check.x_mm, check.y_mm, unknown_noise_mm));
-    const double share = std::max(place.CentreShare(), kMinCheckPointShare);
-    const double figure = kCheckPointMargin * (std::abs(residual) + kCheckPointSigmas * noise) / share;
-    std::optional<double>& cell = checked[place.j * (nx - 1) + place.i];
-    if (!cell || figure > *cell) {
-      cell = figure;
-      checked_by[place.j * (nx - 1) + place.i] = &check;
+    const double own = PointNoiseMm(check.count, pooled, unknown_noise_mm);
+    const double phi = std::max(place.CentreShare(), kMinCheckPointShare);
+    const double noise = std::hypot(own, InterpolationNoiseMm(t, place, pooled, unknown_noise_mm)) / phi;
+    const double p = 4 * place.s * (1 - place.s), q = 4 * place.t * (1 - place.t);
+    seen.push_back({&check, c, residual, noise, CheckFigure(residual, p, q, cx[c], cy[c])});
+  }
+  result.margin = kCheckPointMargin;
+  // The check-point figure of each cell that has one (the largest of its
+  // check points') and its noise.
+  std::vector<std::optional<double>> checked(cells);
+  std::vector<double> checked_noise(cells, 0.0);
+  std::vector<const TableNode*> checked_by(cells);
+  for (const Check& check : seen) {
+    const std::size_t c = check.cell;
+    const double figure = result.margin * check.figure, figure_noise = result.margin * check.noise;
+    if (!checked[c] || figure > *checked[c]) {
+      checked[c] = figure;
+      checked_by[c] = check.node;
     }
-    result.largest_residual_mm = std::max(result.largest_residual_mm, std::abs(residual));
+    checked_noise[c] = std::max(checked_noise[c], figure_noise);
+    result.largest_residual_mm = std::max(result.largest_residual_mm, std::abs(check.residual));
     result.check_points_mm = std::max(result.check_points_mm.value_or(0.0), figure);
+    result.noise_mm = std::max(result.noise_mm, figure_noise);
     ++result.check_points;
   }
   result.pitch_mm = std::max(largest_pitch[0], largest_pitch[1]);
+  result.cell_bound_mm.assign(cells, 0.0);
+  result.cell_noise_mm.assign(cells, 0.0);
 
   auto consider = [&](double figure, InterpolationKind kind, const Eigen::Vector2d& at, const SourceRange& origin) {
     if (figure > result.estimate_mm || result.cells == 0) {
@@ -138,25 +213,29 @@ AxisInterpolation EstimateAxis(const AxisTable& t, const std::optional<DeclaredR
   };
   for (std::size_t j = 0; j + 1 < ny; ++j) {
     for (std::size_t i = 0; i + 1 < nx; ++i) {
+      const std::size_t c = j * (nx - 1) + i;
       const double hx = t.xs[i + 1] - t.xs[i], hy = t.ys[j + 1] - t.ys[j];
       const Eigen::Vector2d centre(0.5 * (t.xs[i] + t.xs[i + 1]), 0.5 * (t.ys[j] + t.ys[j + 1]));
-      double cxx = 0, cyy = 0;
-      for (std::size_t row : {j, j + 1}) cxx = std::max(cxx, CurvatureAlong(t.xs, i, fxx[row]));
-      for (std::size_t column : {i, i + 1}) cyy = std::max(cyy, CurvatureAlong(t.ys, j, fyy[column]));
-      const double curvature = hx * hx / 8 * cxx + hy * hy / 8 * cyy;
+      const double curvature = cx[c] + cy[c];
       result.curvature_mm = std::max(result.curvature_mm, curvature);
-      consider(curvature, InterpolationKind::kCurvature, centre, t.Origin(i, j));
-      ++result.cells;
-      const std::optional<double>& check = checked[j * (nx - 1) + i];
-      if (check) {
-        const TableNode& by = *checked_by[j * (nx - 1) + i];
+      double& bound = result.cell_bound_mm[c];
+      if (checked[c]) {
+        const TableNode& by = *checked_by[c];
         ++result.checked_cells;
-        consider(*check, InterpolationKind::kCheckPoints, {by.x_mm, by.y_mm}, by.error_field);
-      } else if (roughness) {
-        const double declared = DeclaredFigure(*roughness, hidden, std::max(hx, hy));
-        result.declared_mm = std::max(result.declared_mm.value_or(0.0), declared);
-        consider(declared, InterpolationKind::kDeclared, centre, t.Origin(i, j));
+        bound = *checked[c];
+        result.cell_noise_mm[c] = checked_noise[c];
+        consider(bound, InterpolationKind::kCheckPoints, {by.x_mm, by.y_mm}, by.error_field);
+      } else {
+        bound = curvature;
+        consider(curvature, InterpolationKind::kCurvature, centre, t.Origin(i, j));
+        if (roughness) {
+          const double declared = DeclaredFigure(*roughness, hidden, std::max(hx, hy));
+          result.declared_mm = std::max(result.declared_mm.value_or(0.0), declared);
+          bound = std::max(bound, declared);
+          consider(declared, InterpolationKind::kDeclared, centre, t.Origin(i, j));
+        }
       }
+      ++result.cells;
     }
   }
   return result;
@@ -211,19 +290,41 @@ double Interpolate(const AxisTable& table, double x, double y) {
   return (1 - p.t) * ((1 - p.s) * v00 + p.s * v10) + p.t * ((1 - p.s) * v01 + p.s * v11);
 }
 
-double InterpolatedNoiseMm(const AxisTable& table, double x, double y, double unknown_noise_mm) {
-  const CellPlace p = PlaceInCell(table, x, y);
-  double variance = 0;
-  for (int b = 0; b < 2; ++b) {
-    for (int a = 0; a < 2; ++a) {
-      const double weight = (a == 1 ? p.s : 1 - p.s) * (b == 1 ? p.t : 1 - p.t);
-      const double se =
-          table.StandardErrorMm(table.Index(p.i + static_cast<std::size_t>(a), p.j + static_cast<std::size_t>(b)))
-              .value_or(unknown_noise_mm);
-      variance += weight * weight * se * se;
+std::optional<double> PooledReadingScatterMm(const AxisTable& table) {
+  double squares = 0, dof = 0;
+  auto add = [&](const std::optional<double>& stddev, int count) {
+    if (!stddev || count < 2) return;
+    squares += (count - 1) * *stddev * *stddev;
+    dof += count - 1;
+  };
+  for (std::size_t k = 0; k < table.error_mm.size(); ++k) {
+    add(k < table.stddev_mm.size() ? table.stddev_mm[k] : std::nullopt, k < table.count.size() ? table.count[k] : 0);
+  }
+  for (const TableNode& check : table.checks) add(check.stddev_mm, check.count);
+  if (!(dof > 0)) return std::nullopt;
+  return std::sqrt(squares / dof);
+}
+
+LocalInterpolation AxisInterpolation::Over(const Rect& box) const {
+  LocalInterpolation local;
+  if (xs.size() < 2 || ys.size() < 2 || cell_bound_mm.empty()) return local;
+  const std::size_t i0 = CellOf(xs, std::clamp(box.x0, xs.front(), xs.back()));
+  const std::size_t i1 = CellOf(xs, std::clamp(box.x1, xs.front(), xs.back()));
+  const std::size_t j0 = CellOf(ys, std::clamp(box.y0, ys.front(), ys.back()));
+  const std::size_t j1 = CellOf(ys, std::clamp(box.y1, ys.front(), ys.back()));
+  // And one ring of cells around them: on a grid that is coarse for the
+  // field a cell's own evidence can miss a departure its neighbours see.
+  const std::size_t nx = xs.size() - 1, ny = ys.size() - 1;
+  const std::size_t ilo = std::min(i0, i1) > 0 ? std::min(i0, i1) - 1 : 0, ihi = std::min(std::max(i0, i1) + 1, nx - 1);
+  const std::size_t jlo = std::min(j0, j1) > 0 ? std::min(j0, j1) - 1 : 0, jhi = std::min(std::max(j0, j1) + 1, ny - 1);
+  for (std::size_t j = jlo; j <= jhi; ++j) {
+    for (std::size_t i = ilo; i <= ihi; ++i) {
+      const std::size_t c = j * nx + i;
+      local.bound_mm = std::max(local.bound_mm, cell_bound_mm[c]);
+      local.noise_mm = std::max(local.noise_mm, cell_noise_mm[c]);
     }
   }
-  return std::sqrt(variance);
+  return local;
 }
 
 InterpolationEstimate EstimateInterpolationError(const ErrorTable& table,

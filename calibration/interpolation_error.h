@@ -1,21 +1,27 @@
 // How far the robot's error may depart from the bilinear interpolation
 // between an error table's nodes (docs/error-tables.md, "Between the nodes").
 // The nodes are measured; the interpolation between them is an assumption,
-// and on a coarse grid a large one. Per axis table, three figures of the
-// largest departure anywhere in the table (mm):
+// and on a coarse grid a large one. Per axis table and per cell of its grid,
+// a bound on the largest departure (mm) from three kinds of evidence:
 //
-//   - check points (readings off the nodes, kept in the table, kind = check):
-//     each check point's residual, measured minus interpolated, plus 4 sigma
-//     of its noise (its own readings and the interpolated nodes'), scaled to
-//     its cell's centre (a check point at (s, t) of its cell sees the share
-//     phi = 2 (s(1-s) + t(1-t)) of the centre's error of a quadratic field)
-//     and by kCheckPointMargin for what lies between it and the nodes. The
-//     measured figure of every cell that has one.
 //   - curvature: second differences of the nodes along each axis give each
-//     cell's mid-cell error of a bilinear fit of a smooth field,
-//     h_x^2/8 |f_xx| + h_y^2/8 |f_yy|. A lower bound: it cannot see a
-//     departure the grid aliases (a wave shorter than a few pitches). The
-//     node noise is left in the second differences (pessimistic).
+//     cell's departure of a bilinear fit of a locally quadratic field,
+//     d(s, t) = A p(s) + B q(t) with p = 4 s(1-s), q = 4 t(1-t),
+//     |A| <= c_x = h_x^2/8 |f_xx|, |B| <= c_y = h_y^2/8 |f_yy| (|f''| the
+//     largest at the cell's nodes). Without a check point: c_x + c_y, a
+//     lower bound (it cannot see a departure the grid aliases).
+//   - check points (readings off the nodes, kept in the table, kind =
+//     check): a check point's residual r, measured minus interpolated, is an
+//     unbiased estimate of the departure there (its noise has mean zero). At
+//     a cell's centre it says A + B = r, so the quadratic model's largest
+//     departure in the cell is max(|r|, min(c_x, |r| + c_y), min(c_y, |r| +
+//     c_x)); off the centre (share phi = (p + q)/2 of the centre's) and
+//     where r is more than the curvature allows, max(|r| / phi, c_x + c_y).
+//     Times kCheckPointMargin for what the quadratic model misses. The
+//     residual's noise (the check point's and its interpolated nodes'
+//     standard errors, from the table's pooled reading scatter) is kept
+//     apart as a standard deviation: the budget adds it to its random part,
+//     never to the bound.
 //   - declared roughness (when the cell declares its robot's accuracy A and
 //     correlation length L): the mid-cell error a (1 - cos(pi h / 3L)), for
 //     a cell of largest pitch h, of the largest wave of the shortest
@@ -26,10 +32,12 @@
 //     line: a = A). What the nodes cannot rule out; a check point in the
 //     cell replaces it.
 //
-// The estimate of an axis table is the largest of: the curvature figure
-// (everywhere), the check-point figure of every cell with a check point, and
-// the declared figure of every cell without one. It enters the placement
-// budget as a bound (calibration/placement_budget.h).
+// A cell's bound is its check-point figure when it has a check point, else
+// the larger of its curvature and declared figures. The estimate of an axis
+// table is its largest cell bound, with the largest noise of its check-point
+// figures. It enters the placement budget as a bound plus a random part
+// (calibration/placement_budget.h); the budget of a fixture target looks up
+// the cells under each trip (AxisInterpolation::Over).
 #pragma once
 
 #include <algorithm>
@@ -37,6 +45,7 @@
 #include <cstddef>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -45,16 +54,14 @@
 
 namespace smtcal {
 
-// A check point's figure is its residual (plus noise) scaled to its cell's
-// centre and then by this: between a check point and the nodes the field can
-// depart a little more than at the check point itself. 1.25 covers every
-// random smooth field of the property test whose shortest wavelength is 2.5
-// pitches (without it: up to 1.24 x the figure, seed 7 of 1..40 and 19940101,
-// so little slack; tests/unit/calibration/interpolation_error_test.cpp).
-inline constexpr double kCheckPointMargin = 1.25;
-// The noise of a check point's residual is taken at this many standard
-// deviations (the budget's 4 sigma).
-inline constexpr double kCheckPointSigmas = 4;
+// A check-point figure is the quadratic model's largest departure in its
+// cell times this: what a smooth field's departure from the model (third
+// and higher orders, a second difference that averages the curvature over
+// two pitches) adds. The property test (random smooth fields whose shortest
+// wavelength is 2.5 to 24 pitches, at 2, 5, 10 and 25 mm:
+// tests/unit/calibration/interpolation_error_test.cpp) measures what it must
+// cover; docs/error-tables.md gives the figures.
+inline constexpr double kCheckPointMargin = 1.3;
 // A check point whose share phi of its cell's centre error is below this is
 // too close to a node to show the interpolation error (a tenth of a pitch
 // along both axes from a node, or less): an error in the table file.
@@ -100,19 +107,33 @@ struct CellPlace {
 // The point must lie within the table's grid rectangle (bounds included).
 CellPlace PlaceInCell(const AxisTable& table, double x, double y);
 
-// The bilinear interpolation of an axis table at a point of its rectangle,
-// and the standard deviation of that value from the nodes' noise
-// (sum of w_k^2 se_k^2; a node without stddev and count counts as
-// `unknown_noise_mm`).
+// The bilinear interpolation of an axis table at a point of its rectangle.
 double Interpolate(const AxisTable& table, double x, double y);
-double InterpolatedNoiseMm(const AxisTable& table, double x, double y, double unknown_noise_mm);
+
+// The scatter of one reading of an axis table (mm), pooled over its nodes and
+// check points that state a stddev and a count of 2 or more:
+// sqrt(sum (n - 1) s^2 / sum (n - 1)). The readings of one table come from
+// one measuring set-up, so one figure serves every point: a point of two
+// readings whose two happened to agree has scatter 0 of its own, not the
+// set-up's. nullopt when no point states one.
+std::optional<double> PooledReadingScatterMm(const AxisTable& table);
+
+// The bound and the noise of the departure over a part of a table.
+struct LocalInterpolation {
+  double bound_mm = 0;  // the largest cell bound there
+  double noise_mm = 0;  // the largest standard deviation of those bounds' check points
+};
 
 struct AxisInterpolation {
-  double estimate_mm = 0;  // the largest of the figures below, as described above
-  InterpolationKind kind = InterpolationKind::kCurvature;  // which figure it is
+  // The largest departure anywhere in the table: the largest cell bound
+  // (as described above), with `noise_mm` the standard deviation of the
+  // check-point figures (the largest over the checked cells; 0 without).
+  double estimate_mm = 0;
+  double noise_mm = 0;
+  InterpolationKind kind = InterpolationKind::kCurvature;  // which figure the estimate is
   Eigen::Vector2d at = Eigen::Vector2d::Zero();  // the cell centre (or check point) it comes from
   SourceRange origin;  // where that is written: the check point's row, or the cell's first node's
-  double curvature_mm = 0;                   // the curvature figure: a lower bound
+  double curvature_mm = 0;                   // the largest curvature figure c_x + c_y: a lower bound
   std::optional<double> check_points_mm;     // the largest check-point figure (when there are any)
   std::optional<double> declared_mm;         // the declared figure of the coarsest cell (when declared)
   std::size_t cells = 0, checked_cells = 0;  // cells, and cells with a check point
@@ -120,16 +141,32 @@ struct AxisInterpolation {
   double pitch_mm = 0;  // the table's largest pitch along either axis
   // The largest check-point residual |measured - interpolated| (no noise, no scaling).
   double largest_residual_mm = 0;
+  // The margin the check-point figures were taken with (kCheckPointMargin).
+  double margin = 0;
+  // The reading scatter the noise comes from (PooledReadingScatterMm), when
+  // the table states one.
+  std::optional<double> reading_scatter_mm;
+  // Per cell (j (nx - 1) + i of the grid lines xs, ys): its bound and noise.
+  std::vector<double> xs, ys;
+  std::vector<double> cell_bound_mm, cell_noise_mm;
+
+  // The largest bound and noise of the cells that meet the rectangle
+  // [x0, x1] x [y0, y1] (clipped to the grid; a rectangle outside it meets
+  // the nearest cells).
+  LocalInterpolation Over(const Rect& box) const;
 };
 
 struct InterpolationEstimate {
   std::array<AxisInterpolation, 2> axes;  // [X] of the Delta-x table, [Y] of the Delta-y table
 
   const AxisInterpolation& operator[](TableAxis axis) const { return axes[static_cast<int>(axis)]; }
-  // Per axis (Delta-x, Delta-y).
+  // Per axis (Delta-x, Delta-y): the bounds, and their noise's standard deviations.
   Eigen::Vector2d PerAxisMm() const { return {axes[0].estimate_mm, axes[1].estimate_mm}; }
+  Eigen::Vector2d PerAxisNoiseMm() const { return {axes[0].noise_mm, axes[1].noise_mm}; }
   // The length of the largest departure vector: |(E_x, E_y)|.
   double NormMm() const { return PerAxisMm().norm(); }
+  // The larger of the two noises: the departure's standard deviation in its worst direction.
+  double NoiseMm() const { return std::max(axes[0].noise_mm, axes[1].noise_mm); }
   // The larger of the two tables' pitches.
   double PitchMm() const { return std::max(axes[0].pitch_mm, axes[1].pitch_mm); }
   // The kind and the origin of the axis with the larger estimate.
@@ -148,6 +185,8 @@ InterpolationEstimate EstimateInterpolationError(const ErrorTable& table,
 
 // The paper's rule made quantitative: start with the pitch as large as
 // possible and decrease it until the result is satisfactory.
+// The advice is about the departure (the bounds): the check points' noise is
+// no matter of pitch (more repetitions narrow it).
 struct GridAdvice {
   double share = 0;        // the estimate's norm as a share of the tolerance
   bool coarse = false;     // share > kInterpolationShareOfTolerance

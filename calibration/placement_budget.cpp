@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <optional>
 
@@ -25,6 +26,27 @@ bool WindowInDomain(const TripWindow& window, const Rect& domain) {
     return p.x() >= domain.x0 && p.x() <= domain.x1 && p.y() >= domain.y0 && p.y() <= domain.y1;
   };
   return inside(window.from) && inside(window.to) && inside(window.nominal);
+}
+
+// The departure from the tables' interpolation across a trip's edge
+// (`across`, a unit vector), wherever the trip may fall in its window: the
+// largest cell bound of each axis table over the window, |n_x| E_x + |n_y|
+// E_y, and the noise of those bounds, sqrt(n_x^2 s_x^2 + n_y^2 s_y^2) (the
+// two axis tables are measured apart).
+LocalInterpolation TripInterpolationAcross(const InterpolationEstimate& estimate, const TripWindow& window,
+                                           const Eigen::Vector2d& across) {
+  Rect box{window.nominal.x(), window.nominal.x(), window.nominal.y(), window.nominal.y()};
+  for (const Eigen::Vector2d& p : {window.from, window.to}) {
+    box.x0 = std::min(box.x0, p.x());
+    box.x1 = std::max(box.x1, p.x());
+    box.y0 = std::min(box.y0, p.y());
+    box.y1 = std::max(box.y1, p.y());
+  }
+  const LocalInterpolation x = estimate.axes[0].Over(box), y = estimate.axes[1].Over(box);
+  LocalInterpolation local;
+  local.bound_mm = std::abs(across.x()) * x.bound_mm + std::abs(across.y()) * y.bound_mm;
+  local.noise_mm = std::hypot(across.x() * x.noise_mm, across.y() * y.noise_mm);
+  return local;
 }
 
 }  // namespace
@@ -101,6 +123,45 @@ Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatabili
   return se;
 }
 
+double WorstCaseSumMm(const std::vector<Eigen::Vector2d>& terms) {
+  // |sum s_k v_k| is largest for the signs s_k = sign(u . v_k) of some
+  // direction u, and those signs change only where u is perpendicular to a
+  // v_k: one candidate per arc between those directions.
+  std::vector<double> breaks;
+  for (const Eigen::Vector2d& v : terms) {
+    if (!(v.norm() > 0)) continue;
+    const double angle = std::atan2(v.y(), v.x());
+    for (double b : {angle + 0.5 * std::numbers::pi, angle - 0.5 * std::numbers::pi}) {
+      breaks.push_back(std::remainder(b, 2 * std::numbers::pi) + std::numbers::pi);  // in [0, 2 pi]
+    }
+  }
+  if (breaks.empty()) return 0;
+  std::sort(breaks.begin(), breaks.end());
+  double largest = 0;
+  for (std::size_t k = 0; k < breaks.size(); ++k) {
+    const double next = k + 1 < breaks.size() ? breaks[k + 1] : breaks.front() + 2 * std::numbers::pi;
+    const double mid = 0.5 * (breaks[k] + next);
+    const Eigen::Vector2d u(std::cos(mid), std::sin(mid));
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& v : terms) sum += u.dot(v) >= 0 ? v : Eigen::Vector2d(-v);
+    largest = std::max(largest, sum.norm());
+  }
+  return largest;
+}
+
+ErrorShare RegionInterpolationShare(const InterpolationEstimate& estimate) {
+  // The departure is systematic: the same every time the robot goes there,
+  // so a bound (taken in its worst direction by the process figures), never
+  // a random part that could average out. What the check points cannot tell
+  // from their own noise is random: their residuals' standard deviations.
+  ErrorShare share;
+  const Eigen::Vector2d noise = estimate.PerAxisNoiseMm();
+  share.bound_mm = estimate.NormMm();
+  share.covariance_mm2 = noise.cwiseAbs2().asDiagonal();
+  share.worst_mm = share.bound_mm + kBudgetSigmas * noise.norm();
+  return share;
+}
+
 ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm) {
   return StaticBudget(cell, region, residual_mm,
                       region != nullptr ? TableStandardErrorMm(region->table, cell.robot.repeatability_mm)
@@ -129,11 +190,7 @@ ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, dou
     ErrorShare& table = budget[ErrorSource::kTable];
     table.covariance_mm2 = se.cwiseAbs2().asDiagonal();
     table.worst_mm = kBudgetSigmas * se.norm();
-    // Systematic: the same departure every time the robot goes there, so a
-    // bound (taken in its worst direction by the process figures), never a
-    // random part that could average out.
-    ErrorShare& interpolation = budget[ErrorSource::kInterpolation];
-    interpolation.bound_mm = interpolation.worst_mm = region->interpolation.NormMm();
+    budget[ErrorSource::kInterpolation] = RegionInterpolationShare(region->interpolation);
   }
   return budget;
 }
@@ -157,6 +214,7 @@ FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture
       latency_mm_(fixture.TripLatchSpeedMmS() * cell.robot.servo_period_s),
       region_table_se_(region_table_se.empty() ? RegionTableNoise(cell) : std::move(region_table_se)) {
   trip_regions_ = TripRegions(fixture, cell.regions);
+  const std::vector<TripWindow> windows = TripWindows(fixture);
   const std::vector<ExpectedTrip> expected = ExpectedTrips(fixture);
   const Eigen::Affine3d nominal = NominalFix(fixture);
   const std::vector<Eigen::Vector2d> trips = NominalTrips(fixture, nominal);
@@ -177,15 +235,16 @@ FixtureErrorModel::FixtureErrorModel(const cell::Cell& cell, const cell::Fixture
     d_linear_.push_back((a->fix.linear().topLeftCorner<2, 2>() - b->fix.linear().topLeftCorner<2, 2>()) / (2 * h));
     d_origin_.push_back((FixOrigin(a->fix) - FixOrigin(b->fix)) / (2 * h));
     leg_across_.push_back(expected[k].leg_direction.dot(normal));
-    double se = 0, interpolation = 0;
+    double se = 0;
+    LocalInterpolation interpolation;
     if (trip_regions_[k] >= 0) {
       const cell::Region& region = cell.regions[static_cast<std::size_t>(trip_regions_[k])];
       const Eigen::Vector2d axis_se = TableStandardErrorMm(region.table, cell.robot.repeatability_mm);
       se = std::sqrt(across.cwiseAbs2().dot(axis_se.cwiseAbs2()));
-      interpolation = across.cwiseAbs().dot(region.interpolation.PerAxisMm());
+      interpolation = TripInterpolationAcross(region.interpolation, windows[k], across);
     }
     trip_table_se_.push_back(se);
-    trip_interpolation_mm_.push_back(interpolation);
+    trip_interpolation_.push_back(interpolation);
   }
   defined_ = true;
 }
@@ -213,7 +272,6 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
   ErrorShare& scan_repeat = budget[ErrorSource::kScanRepeatability];
   ErrorShare& latency = budget[ErrorSource::kLatency];
   ErrorShare& trip_tables = budget[ErrorSource::kTripTables];
-  ErrorShare& interpolation = budget[ErrorSource::kInterpolation];
   ErrorShare& uncalibrated = budget[ErrorSource::kUncalibratedTrips];
   for (std::size_t k = 0; k < d_linear_.size(); ++k) {
     const Eigen::Vector2d g = d_linear_[k] * point_in_fixture + d_origin_[k];
@@ -232,10 +290,6 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
     if (trip_regions_[k] >= 0) {
       trip_tables.covariance_mm2 += trip_table_se_[k] * trip_table_se_[k] * gg;
       trip_tables.worst_mm += kBudgetSigmas * trip_table_se_[k] * gain;
-      // Every trip's departure at its worst, all moving the point the same
-      // way: the departures are systematic and need not cancel.
-      interpolation.bound_mm += gain * trip_interpolation_mm_[k];
-      interpolation.worst_mm += gain * trip_interpolation_mm_[k];
     } else if (robot.uncalibrated_accuracy_mm) {
       uncalibrated.bound_mm += gain * *robot.uncalibrated_accuracy_mm;
       uncalibrated.worst_mm += gain * *robot.uncalibrated_accuracy_mm;
@@ -243,7 +297,47 @@ ErrorBudget FixtureErrorModel::At(const Eigen::Vector2d& point_in_fixture, const
       budget.bounded = false;
     }
   }
+  budget[ErrorSource::kInterpolation] = Interpolation(point_in_fixture, region);
   return budget;
+}
+
+std::vector<Eigen::Vector2d> FixtureErrorModel::TripGains(const Eigen::Vector2d& point_in_fixture) const {
+  std::vector<Eigen::Vector2d> gains;
+  for (std::size_t k = 0; k < d_linear_.size(); ++k) gains.push_back(d_linear_[k] * point_in_fixture + d_origin_[k]);
+  return gains;
+}
+
+ErrorShare FixtureErrorModel::Interpolation(const Eigen::Vector2d& point_in_fixture, const cell::Region* region) const {
+  ErrorShare share = region != nullptr ? RegionInterpolationShare(region->interpolation) : ErrorShare{};
+  if (!defined_) return share;
+  // The bound: the largest displacement the departures can make together,
+  // each anywhere within its bound: the target region's along x and y, and
+  // each calibrated trip's across its edge through the estimator (g_k). The
+  // exact worst case of the linear map over that box (WorstCaseSumMm), not
+  // the sum of each part's worst: a trip pair on one edge moves the board
+  // alike, trips on crossing edges do not.
+  std::vector<Eigen::Vector2d> terms;
+  if (region != nullptr) {
+    const Eigen::Vector2d own = region->interpolation.PerAxisMm();
+    terms = {Eigen::Vector2d(own.x(), 0), Eigen::Vector2d(0, own.y())};
+  }
+  // The noise: the trips under one table may share a check point's noise,
+  // so per table the worst sum of its trips' noises, in any direction.
+  std::map<int, std::vector<Eigen::Vector2d>> noise_by_region;
+  const std::vector<Eigen::Vector2d> gains = TripGains(point_in_fixture);
+  for (std::size_t k = 0; k < gains.size(); ++k) {
+    if (trip_regions_[k] < 0) continue;
+    terms.push_back(trip_interpolation_[k].bound_mm * gains[k]);
+    noise_by_region[trip_regions_[k]].push_back(trip_interpolation_[k].noise_mm * gains[k]);
+  }
+  share.bound_mm = WorstCaseSumMm(terms);
+  share.worst_mm = share.bound_mm + (region != nullptr ? kBudgetSigmas * region->interpolation.PerAxisNoiseMm().norm() : 0.0);
+  for (const auto& [r, noises] : noise_by_region) {
+    const double sigma = WorstCaseSumMm(noises);
+    share.covariance_mm2 += sigma * sigma * Eigen::Matrix2d::Identity();
+    share.worst_mm += kBudgetSigmas * sigma;
+  }
+  return share;
 }
 
 Eigen::Matrix3d FixtureErrorModel::PoseCovariance() const {

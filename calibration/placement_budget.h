@@ -12,7 +12,8 @@
 //     robot's error departs from the tables' interpolation between their
 //     nodes, at the placement and at the trips),
 //   - a random part with a covariance (repeatability, the sensor, the
-//     tables' own measurement noise, the latency's spread).
+//     tables' own measurement noise, the latency's spread, the noise of the
+//     check points that show the departure from the interpolation).
 // Random parts come from bounded uniform draws (the cell's "±" figures) or
 // from the tables' standard errors. Through the fixture's estimator a trip's
 // error reaches a fixture point linearly: the sensitivity G_k(f) of the point
@@ -94,10 +95,21 @@ struct ErrorBudget {
 // repeatability as its spread.
 Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatability_mm);
 
+// The largest |sum_k s_k v_k| over the signs s_k = +-1: the largest length
+// a sum of terms, each anywhere between -v_k and +v_k, can reach. Exact (one
+// sign pattern per arc of directions between the terms' normals).
+double WorstCaseSumMm(const std::vector<Eigen::Vector2d>& terms);
+
+// The interpolation part of a placement in a region, on its own: the bound
+// |(E_x, E_y)| of the departure (a bound: systematic), and the noise of the
+// check points that show it, diag(s_x^2, s_y^2) (random)
+// (calibration/interpolation_error.h).
+ErrorShare RegionInterpolationShare(const InterpolationEstimate& estimate);
+
 // A placement corrected through a region's table with no fixture (a static
 // target): the residual, the repeatability, the table's noise and its
-// interpolation error (region->interpolation, as a bound on the length of
-// the departure vector). `region` may be null (then only the repeatability).
+// interpolation error (RegionInterpolationShare). `region` may be null (then
+// only the repeatability).
 ErrorBudget StaticBudget(const cell::Cell& cell, const cell::Region* region, double residual_mm);
 // The same with the region's TableStandardErrorMm given: a compile asks for
 // every target's budget, so the tables' noise is found once (RegionTableNoise).
@@ -126,12 +138,29 @@ class FixtureErrorModel {
   // is unbounded).
   bool defined() const { return defined_; }
   const std::vector<int>& trip_regions() const { return trip_regions_; }
+  // Per trip: its calibrating table's departure across its edge over its
+  // window, a bound and its noise (0 for a trip no table calibrates).
+  const std::vector<LocalInterpolation>& trip_interpolation() const { return trip_interpolation_; }
   // Trips (0-based) no table calibrates.
   std::vector<std::size_t> UncalibratedTrips() const;
 
   // The whole budget of a placement at `point_in_fixture`, corrected through
   // `region` (may be null) with that residual.
   ErrorBudget At(const Eigen::Vector2d& point_in_fixture, const cell::Region* region, double residual_mm) const;
+
+  // The budget's `interpolation` part of that placement (At's): the
+  // departures from the tables' interpolation of the target's region (may be
+  // null: then the trips' alone) and of every calibrated trip, each
+  // anywhere within its bound (for a trip: the bounds of the cells its
+  // window meets, across its edge), combined exactly through the
+  // estimator's sensitivities (WorstCaseSumMm); the check points' noise as
+  // a random part, per table in its worst direction. Without a region it is
+  // the part through the trips (docs/compile.md, "The tolerance budget").
+  ErrorShare Interpolation(const Eigen::Vector2d& point_in_fixture, const cell::Region* region) const;
+
+  // How a fixture point moves with each trip moving across its edge (mm per
+  // mm): the sensitivities g_k(f) of the estimator at the nominal pose.
+  std::vector<Eigen::Vector2d> TripGains(const Eigen::Vector2d& point_in_fixture) const;
 
   // The covariance of the scanned pose (origin x, y in mm; angle in rad)
   // from the random part of every trip's error: the sensor, the robot's
@@ -150,9 +179,9 @@ class FixtureErrorModel {
   std::vector<Eigen::Vector2d> d_origin_;
   std::vector<double> leg_across_;    // |leg direction . edge normal|: the latency's share across the edge
   std::vector<double> trip_table_se_;  // the calibrating table's standard error across the edge; 0 if none
-  // The calibrating table's interpolation error across the edge (a bound:
-  // |n_x| E_x + |n_y| E_y); 0 if none.
-  std::vector<double> trip_interpolation_mm_;
+  // The calibrating table's departure from its interpolation across the
+  // edge, over the trip's window (a bound and its check points' noise); 0 if none.
+  std::vector<LocalInterpolation> trip_interpolation_;
   std::vector<Eigen::Vector2d> region_table_se_;  // RegionTableNoise of the cell
   Eigen::Vector2d nominal_x_axis_ = Eigen::Vector2d::UnitX();  // n of the nominal FIX
 };

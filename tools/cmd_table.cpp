@@ -46,14 +46,13 @@ std::string BaseName(const std::string& path) { return std::filesystem::path(pat
 
 // The interpolation estimate of a table on its own: no cell, so no declared
 // roughness; a node or check point that states no noise counts as one
-// reading with the largest stddev the table states (0 when it states none).
+// reading of the table's pooled reading scatter (the other axis's when its
+// own states none; 0 when the table states none, where a cell counts its
+// robot's repeatability instead: docs/error-tables.md).
 InterpolationEstimate TableInterpolation(const ErrorTable& table) {
-  double largest = 0;
-  for (const AxisTable& t : table.axes) {
-    for (const auto& sd : t.stddev_mm) largest = std::max(largest, sd.value_or(0.0));
-    for (const TableNode& check : t.checks) largest = std::max(largest, check.stddev_mm.value_or(0.0));
-  }
-  return EstimateInterpolationError(table, std::nullopt, largest);
+  double scatter = 0;
+  for (const AxisTable& t : table.axes) scatter = std::max(scatter, PooledReadingScatterMm(t).value_or(0.0));
+  return EstimateInterpolationError(table, std::nullopt, scatter);
 }
 
 // Loads and validates a table. Returns nullopt after setting the exit code

@@ -96,8 +96,12 @@ std::string InterpolationText(const InterpolationEstimate& estimate, double tole
   const std::size_t checked = estimate.axes[0].checked_cells + estimate.axes[1].checked_cells;
   const std::size_t cells = estimate.axes[0].cells + estimate.axes[1].cells;
   if (estimate.HasCheckPoints()) {
-    text += fmt::format("; check points in {} of {} cells, largest residual {} mm", checked, cells,
-                        Fixed(std::max(estimate.axes[0].largest_residual_mm, estimate.axes[1].largest_residual_mm), 4));
+    const bool stated = estimate.axes[0].reading_scatter_mm || estimate.axes[1].reading_scatter_mm;
+    text += fmt::format("; check points in {} of {} cells, largest residual {} mm, their noise σ {} mm{}", checked,
+                        cells,
+                        Fixed(std::max(estimate.axes[0].largest_residual_mm, estimate.axes[1].largest_residual_mm), 4),
+                        Fixed(estimate.NoiseMm(), 4),
+                        stated ? std::string(" (a random part)") : std::string(" (the table states no scatter)"));
   }
   if (advice.coarse) {
     text += fmt::format("; more than {} %: measure at a pitch of at most {} mm (it has {} mm){}",
@@ -124,11 +128,14 @@ nlohmann::ordered_json InterpolationJson(const InterpolationEstimate& estimate, 
                                          {"check_points", a.check_points},
                                          {"cells", a.cells},
                                          {"checked_cells", a.checked_cells},
+                                         {"noise_mm", Round6(a.noise_mm)},
+                                         {"reading_scatter_mm", optional(a.reading_scatter_mm)},
                                          {"pitch_mm", Round6(a.pitch_mm)}};
   }
   return {{"mm", Round6(estimate.NormMm())},
           {"x_mm", Round6(estimate.axes[0].estimate_mm)},
           {"y_mm", Round6(estimate.axes[1].estimate_mm)},
+          {"noise_mm", Round6(estimate.NoiseMm())},
           {"kind", InterpolationKindName(estimate.Kind())},
           {"lower_bound", estimate.Kind() == InterpolationKind::kCurvature},
           {"tolerance_mm", tolerance_mm},

@@ -40,9 +40,10 @@ std::string FormatStatsJson(const ErrorTable& table, const TableStats& stats, co
 
 // The interpolation estimate (calibration/interpolation_error.h) in one line:
 // "0.0078 mm (Δx 0.0055, Δy 0.0055 mm), 7.8 % of ±0.1 mm, from ...", with
-// the check points and the grid advice when there is any.
+// the check points (and the standard deviation of their noise, which the
+// budget takes as a random part) and the grid advice when there is any.
 std::string InterpolationText(const InterpolationEstimate& estimate, double tolerance_mm);
-// The same as JSON: {"mm", "x_mm", "y_mm", "kind", "lower_bound", "share",
+// The same as JSON: {"mm", "x_mm", "y_mm", "noise_mm", "kind", "lower_bound", "share",
 // "tolerance_mm", "coarse", "advice_pitch_mm", "check_points_would_settle",
 // "axes": {"x": {...}, "y": {...}}}, lengths rounded to a nanometre.
 nlohmann::ordered_json InterpolationJson(const InterpolationEstimate& estimate, double tolerance_mm);

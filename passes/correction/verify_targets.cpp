@@ -138,12 +138,14 @@ class VerifyTargets final : public Pass {
 
   // Which tables to measure at what pitch when the interpolation between
   // their nodes takes too much of a budget: the target's own region and the
-  // regions under its fixture's trips. The part scales with the pitch
-  // squared; everything else stays.
+  // regions under its fixture's trips. Each table's advice is its grid
+  // advice (AdviseGrid: what cell check, table check and measure plan say of
+  // it); when every table is within its share and the trips still carry too
+  // much, the pitch at which the budget would fit (the departures scale with
+  // the pitch squared; everything else stays).
   static std::string InterpolationHint(const ErrorBudget& budget, const Target& target, const CompileState& state) {
-    const double part = budget[ErrorSource::kInterpolation].bound_mm;
+    const ErrorShare& part = budget[ErrorSource::kInterpolation];
     const double own = target.region->interpolation.NormMm();
-    const double allowed = target.region->tolerance_mm - (target.budget_mm - part);
     std::vector<const cell::Region*> regions = {target.region};
     if (target.fixture >= 0) {
       const FixtureErrorModel& model = state.ErrorModelFor(*state.fixtures[target.fixture].cell_fixture);
@@ -154,29 +156,40 @@ class VerifyTargets final : public Pass {
         }
       }
     }
-    std::string names;
+    std::string names, advice;
     double pitch = 0;
     bool declared = false;
     for (const cell::Region* region : regions) {
       names += fmt::format("{}'{}'", names.empty() ? "" : ", ", region->name);
       pitch = std::max(pitch, region->interpolation.PitchMm());
-      declared = declared || region->interpolation.Kind() == InterpolationKind::kDeclared;
+      const GridAdvice grid = AdviseGrid(region->interpolation, region->tolerance_mm);
+      if (!grid.coarse) continue;
+      advice += fmt::format("{}'{}' at a pitch of at most {:.1f} mm", advice.empty() ? "" : ", ", region->name,
+                            grid.pitch_mm);
+      declared = declared || grid.check_points_would_settle;
     }
-    const double new_pitch = PitchForShare(pitch, part, allowed);
     const std::string through_trips =
-        target.fixture >= 0 ? fmt::format(" and {:.4f} mm more through the trips", part - own) : std::string();
+        target.fixture >= 0 ? fmt::format(" and {:.4f} mm more through the trips", part.bound_mm - own) : std::string();
+    const std::string noise =
+        part.SigmaMm() > 0 ? fmt::format(" (and the check points' noise, σ {:.4f} mm)", part.SigmaMm()) : std::string();
     std::string text = fmt::format(
         "between the nodes of the table{} of region{} {} (largest pitch {} mm) the robot's error may depart from the "
-        "interpolation by {:.4f} mm here{}, {}; ",
+        "interpolation by {:.4f} mm here{}{}, {}; ",
         regions.size() == 1 ? "" : "s", regions.size() == 1 ? "" : "s", names, fmt::format("{:.1f}", pitch), own,
-        through_trips, InterpolationKindDescription(target.region->interpolation.Kind()));
+        through_trips, noise, InterpolationKindDescription(target.region->interpolation.Kind()));
+    if (!advice.empty()) {
+      text += "measure " + advice;
+      if (declared) text += ", or measure check points at the cell centres (docs/error-tables.md)";
+      return text;
+    }
+    const double allowed = target.region->tolerance_mm - (target.budget_mm - part.bound_mm);
+    const double new_pitch = PitchForShare(pitch, part.bound_mm, allowed);
+    text += fmt::format("every table is within {:.0f} % of its tolerance between its nodes, but together they take "
+                        "too much of this budget; ",
+                        100 * kInterpolationShareOfTolerance);
     text += new_pitch > 0 ? fmt::format("measure {} at a pitch of at most {:.1f} mm", regions.size() == 1 ? "it" : "them",
                                         new_pitch)
                           : std::string("no pitch fits while the other parts take the whole tolerance");
-    if (declared) {
-      text += fmt::format(", or measure check points at {} cell centres (docs/error-tables.md)",
-                          regions.size() == 1 ? "its" : "their");
-    }
     return text;
   }
 
