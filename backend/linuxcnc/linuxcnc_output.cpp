@@ -387,6 +387,15 @@ class DataReader {
     fixture.scan_speed_mm_s = Positive(at + L::kFxScanFeed) / 60;
     fixture.latch_speed_mm_s = Value(at + L::kFxLatchFeed) / 60;  // 0: one stage
     if (fixture.latch_speed_mm_s < 0) Fail(at + L::kFxLatchFeed, "a latch feed below 0");
+    fixture.predicted_window_mm = Value(at + L::kFxPredictedWindow);  // 0: every scan in full
+    if (fixture.predicted_window_mm < 0) Fail(at + L::kFxPredictedWindow, "a predicted window below 0");
+    // The robot's move speed, written into every fixture's record for the
+    // predicted scan's traverses: the same in each.
+    const double traverse_mm_s = Positive(at + L::kFxTraverseFeed) / 60;
+    if (!cell.fixtures.empty() && traverse_mm_s != cell.robot.xy_speed_mm_s) {
+      Fail(at + L::kFxTraverseFeed, "a traverse feed other than the first fixture's");
+    }
+    cell.robot.xy_speed_mm_s = traverse_mm_s;
     const int trips = Integer(at + L::kFxTripCount);
     if (trips < 1 || trips > 64) Fail(at + L::kFxTripCount, "a trip count out of range");
     if (!error_.what.empty()) return;
