@@ -45,6 +45,7 @@ dict_of() {
     cad) echo cad ;;
     previous_json) echo json ;;
     linuxcnc_ini) echo ini ;;
+    record_log) echo record ;;
   esac
 }
 

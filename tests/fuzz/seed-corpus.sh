@@ -59,6 +59,9 @@ if hal and os.path.isfile(os.path.join(folder, hal.group(1))):
 open(out, "w").write(text)
 PY
 done
+# Cycle-record logs: the monitor goldens (the long simulated ones go by the
+# 64 KiB rule below).
+seed record_log "$golden"/monitor/*.log
 # The loop that runs the compile-time trace to its 5 000 000-statement limit
 # takes 0.3 s in a release build but 10-90 s under the sanitizers on a busy
 # machine: every mutation of it would be a timeout. The golden suite keeps it.
