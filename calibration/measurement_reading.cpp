@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "calibration/reading_screen.h"
+
 namespace smtcal::measure {
 namespace {
 
@@ -128,6 +130,146 @@ std::vector<ReadingError> ErrorsOfReadings(const cell::Measure& measure, const c
       "off each trip",
       largest_offset, largest_move, late));
   return errors;
+}
+
+namespace {
+
+// The readings of one node along one axis, screened against each other
+// (calibration/reading_screen.h): `values[k]` is what the device read for
+// readings[index[k]].
+void ScreenNode(const std::vector<double>& values, const std::vector<const Reading*>& readings,
+                const std::vector<SourceRange>& where, std::string_view what, double noise_mm,
+                std::string_view plan_name, Diagnostics& diags) {
+  std::vector<long long> sets;
+  for (const Reading* r : readings) sets.push_back(r->set);
+  const ReadingScreen screen = ScreenReadings(values, sets, noise_mm);
+  for (const ReadingOutlier& o : screen.outliers) {
+    const Reading& r = *readings[o.index];
+    diags.Report(DiagKind::MeasureReadingOutlier, where[o.index], what, r.visit, r.repetition,
+                 fmt::format("{:.4f}", values[o.index]), fmt::format("{:.4f}", std::abs(values[o.index] - o.centre_mm)),
+                 r.node, fmt::format("{:.4f}", o.centre_mm), fmt::format("{:.4f}", screen.scatter_mm),
+                 o.slip.kind == SlipKind::kNone ? "" : "; " + o.slip.Describe(), plan_name, r.visit);
+  }
+}
+
+// Groups readings by node (in order of first appearance), each group in
+// reading order.
+std::vector<std::vector<std::size_t>> ByNode(const std::vector<Reading>& readings) {
+  std::map<int, std::size_t> group_of;
+  std::vector<std::vector<std::size_t>> groups;
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    auto [it, fresh] = group_of.try_emplace(readings[k].node, groups.size());
+    if (fresh) groups.emplace_back();
+    groups[it->second].push_back(k);
+  }
+  return groups;
+}
+
+}  // namespace
+
+void CheckReadings(const cell::Measure& measure, const cell::Robot& robot, const std::vector<Reading>& readings,
+                   std::string_view plan_name, Diagnostics& diags) {
+  const std::size_t errors_before = diags.error_count();
+  auto implausible = [&](const Reading& r, std::string what) {
+    diags.Report(DiagKind::MeasureReadingImplausible, r.where, std::move(what), r.visit, plan_name, r.visit);
+  };
+  switch (measure.device) {
+    case cell::MeasureDevice::kTransducer:
+      for (const Reading& r : readings) {
+        for (double value : {r.a, r.b}) {
+          if (measure.transducer.range_mm.Contains(value)) continue;
+          diags.Report(DiagKind::MeasureReadingOutOfRange, r.where, FormatMm(value),
+                       FormatMm(measure.transducer.range_mm.lo), FormatMm(measure.transducer.range_mm.hi), r.visit);
+          break;
+        }
+      }
+      break;
+    case cell::MeasureDevice::kExternal:
+      for (const Reading& r : readings) {
+        if (r.a != 0 || r.b != 0) {
+          implausible(r, fmt::format("the log of an external device holds 0,0 where this line has {:.4g},{:.4g}", r.a,
+                                     r.b));
+        }
+      }
+      return;  // the positions are the external file's: CheckExternalReadings
+    case cell::MeasureDevice::kProbe: {
+      // The probe move along each axis: from the node + s (radius - over)
+      // to + s (radius + over); a trip is latched up to one servo period
+      // of travel late.
+      const Eigen::Vector2d approach = robot.final_approach_mm.value_or(Eigen::Vector2d(1, 1));
+      const double radius = ProbeContactRadiusMm(measure.probe);
+      const double over = measure.probe.overtravel_mm;
+      const double late = measure.probe.speed_mm_s * robot.servo_period_s + 1e-6;
+      for (const Reading& r : readings) {
+        for (int axis = 0; axis < 2; ++axis) {
+          const double s = approach[axis] < 0 ? -1.0 : 1.0;
+          const double along = s * ((axis == 0 ? r.a : r.b) - r.at[axis]);  // how far past the node, towards the wall
+          if (along >= radius - over - 1e-6 && along <= radius + over + late) continue;
+          implausible(r, fmt::format("the trip along {} ({:.6g} mm) lies {:.4g} mm from the node towards the wall, "
+                                     "outside the probe move's {}..{} mm",
+                                     axis == 0 ? "x" : "y", axis == 0 ? r.a : r.b, along,
+                                     FormatComputedMm(radius - over), FormatComputedMm(radius + over)));
+          break;
+        }
+      }
+      break;
+    }
+  }
+  if (diags.error_count() != errors_before) return;
+  // Each node's readings against each other, on what the device read.
+  for (const std::vector<std::size_t>& group : ByNode(readings)) {
+    std::vector<const Reading*> members;
+    std::vector<SourceRange> where;
+    for (std::size_t k : group) {
+      members.push_back(&readings[k]);
+      where.push_back(readings[k].where);
+    }
+    if (measure.device == cell::MeasureDevice::kTransducer) {
+      std::vector<double> values;
+      for (const Reading* r : members) values.push_back(r->a - r->b);
+      ScreenNode(values, members, where, "the transducers' difference", measure.noise_mm, plan_name, diags);
+      continue;
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+      std::vector<double> values;
+      for (const Reading* r : members) values.push_back((axis == 0 ? r->a : r->b) - r->at[axis]);
+      ScreenNode(values, members, where, axis == 0 ? "the probe's trip along x (from the node)"
+                                                   : "the probe's trip along y (from the node)",
+                 measure.noise_mm, plan_name, diags);
+    }
+  }
+}
+
+void CheckExternalReadings(const cell::Measure& measure, const cell::Robot& robot,
+                           const std::vector<Reading>& readings, const std::vector<SourceRange>& where,
+                           std::string_view plan_name, Diagnostics& diags) {
+  const std::size_t errors_before = diags.error_count();
+  const double limit = 2 * robot.uncalibrated_accuracy_mm.value_or(kPlanAssumedAccuracyMm);
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    const Reading& r = readings[k];
+    const double off = (r.external - r.at).norm();
+    if (off <= limit) continue;
+    diags.Report(DiagKind::MeasureReadingImplausible, where[k],
+                 fmt::format("the external system's position ({:.6g}, {:.6g}) lies {:.4g} mm from the node, more "
+                             "than twice the robot's declared error ({} mm)",
+                             r.external.x(), r.external.y(), off, FormatComputedMm(limit / 2)),
+                 r.visit, plan_name, r.visit);
+  }
+  if (diags.error_count() != errors_before) return;
+  for (const std::vector<std::size_t>& group : ByNode(readings)) {
+    std::vector<const Reading*> members;
+    std::vector<SourceRange> at;
+    for (std::size_t k : group) {
+      members.push_back(&readings[k]);
+      at.push_back(where[k]);
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+      std::vector<double> values;
+      for (const Reading* r : members) values.push_back(r->external[axis] - r->at[axis]);
+      ScreenNode(values, members, at, axis == 0 ? "the external system's x error" : "the external system's y error",
+                 measure.noise_mm, plan_name, diags);
+    }
+  }
 }
 
 std::string PlanDigest(std::string_view text) {

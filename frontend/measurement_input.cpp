@@ -2,6 +2,8 @@
 #include "frontend/measurement_input.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -28,6 +30,14 @@ std::string Item(std::string_view header, std::string_view key) {
     at = end + 2;
   }
   return "";
+}
+
+// The visit a cut reading line would have been (its first field), 0 when
+// that is not one of the plan's visits.
+int VisitOfCutLine(std::string_view line, std::size_t visits) {
+  const std::optional<double> v = ParseNumber(line.substr(0, line.find(',')));
+  if (!v || *v != std::floor(*v) || *v < 1 || *v > static_cast<double>(visits)) return 0;
+  return static_cast<int>(*v);
 }
 
 }  // namespace
@@ -127,10 +137,19 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
 std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPlan& plan, Diagnostics& diags) {
   const std::size_t errors_before = diags.error_count();
   const cad::Lines lines(diags.sources(), file);
+  const std::string& text = diags.sources().File(file).text;
   MeasuringLog log;
   log.name = diags.sources().File(file).name;
-  std::map<int, const Visit*> visits;
-  for (const Visit& visit : plan.plan.visits) visits[visit.number] = &visit;
+  const std::vector<Visit>& visits = plan.plan.visits;
+  // The plan's bounds on the whole-number columns.
+  int largest_node = 0, largest_set = 0, largest_repetitions = 0;
+  for (const Visit& v : visits) {
+    largest_node = std::max(largest_node, v.node);
+    largest_set = std::max(largest_set, v.set);
+    largest_repetitions = std::max(largest_repetitions, v.repetitions);
+  }
+  // Per block: the line of each (visit, repetition) read in it.
+  std::map<std::pair<int, int>, std::pair<std::uint32_t, std::size_t>> in_block;  // -> line, reading index
   for (std::uint32_t number = 1; number <= lines.count(); ++number) {
     std::string_view line = lines.Text(number);
     while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
@@ -140,38 +159,67 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
       return std::nullopt;
     }
     if (line.empty()) continue;
+    // A cut line with a resumed run's header glued to it: the cut reading
+    // ends where the header begins.
+    const std::size_t glued = line.find(kLogMark);
+    if (glued != std::string_view::npos && glued > 0) {
+      log.blocks.back().cut = CutLine{VisitOfCutLine(line.substr(0, glued), visits.size()),
+                                      SourceRange(lines.At(number, 0), static_cast<std::uint32_t>(glued))};
+      line = line.substr(glued);
+    }
     if (line.starts_with(kLogMark)) {
+      const SourceRange header_where(lines.At(number, glued == std::string_view::npos ? 0 : glued),
+                                     static_cast<std::uint32_t>(line.size()));
       LogBlock block;
       block.header = std::string(line.substr(2));
+      block.header_range = header_where;
       // "...: plan NAME digest HEX; ...; visits F..L"
       const std::size_t digest_at = line.find(" digest ");
       if (digest_at != std::string_view::npos) {
         std::string_view rest = line.substr(digest_at + 8);
         block.digest = std::string(rest.substr(0, rest.find(';')));
       }
-      std::string range = Item(line, "visits");
-      std::size_t dots = range.find("..");
-      if (dots != std::string::npos) {
-        block.first_visit = std::atoi(range.substr(0, dots).c_str());
-        block.last_visit = std::atoi(range.substr(dots + 2).c_str());
-      }
       if (block.digest != plan.digest) {
-        diags.Report(DiagKind::MeasureLogOtherPlan, where, block.digest.empty() ? "(none)" : block.digest, plan.digest,
-                     Printable(plan.name));
+        diags.Report(DiagKind::MeasureLogOtherPlan, header_where, block.digest.empty() ? "(none)" : Printable(block.digest),
+                     plan.digest, Printable(plan.name));
         return std::nullopt;
       }
+      const std::string range = Item(line, "visits");
+      const std::size_t dots = range.find("..");
+      std::optional<double> first, last;
+      if (dots != std::string::npos) {
+        first = ParseNumber(range.substr(0, dots));
+        last = ParseNumber(range.substr(dots + 2));
+      }
+      const auto whole_visit = [&](std::optional<double> v) {
+        return v && *v == std::floor(*v) && *v >= 1 && *v <= static_cast<double>(visits.size());
+      };
+      if (!whole_visit(first) || !whole_visit(last) || *first > *last) {
+        diags.Report(DiagKind::MeasureLogBadHeader, header_where, Printable(range), visits.size());
+        return std::nullopt;
+      }
+      block.first_visit = static_cast<int>(*first);
+      block.last_visit = static_cast<int>(*last);
       log.blocks.push_back(block);
+      in_block.clear();
       continue;
     }
+    LogBlock& block = log.blocks.back();
     if (line == "# end") {
-      log.blocks.back().ended = true;
+      block.ended = true;
       continue;
     }
     if (line.starts_with("# aborted")) {
-      log.blocks.back().stopped = std::string(line.substr(2));
+      block.stopped = std::string(line.substr(2));
       continue;
     }
     if (line.starts_with("#") || line.starts_with("visit,")) continue;
+    // The last line of the file without its line end: the controller
+    // stopped while writing it.
+    if (number == lines.count() && !text.empty() && text.back() != '\n') {
+      block.cut = CutLine{VisitOfCutLine(line, visits.size()), where};
+      continue;
+    }
     // visit,node,set,repetition,x_mm,y_mm,a_mm,b_mm
     std::vector<std::string_view> fields;
     std::size_t at = 0;
@@ -187,15 +235,22 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
       continue;
     }
     std::array<double, 8> values{};
+    std::array<SourceRange, 8> field_at;
     bool ok = true;
     static constexpr std::array<std::string_view, 8> kColumns = {"visit", "node", "set", "repetition",
                                                                  "x_mm",  "y_mm", "a_mm", "b_mm"};
+    const std::array<int, 4> bounds = {static_cast<int>(visits.size()), largest_node, largest_set,
+                                       largest_repetitions};
     std::uint32_t column = 0;
     for (std::size_t f = 0; f < 8; ++f) {
+      field_at[f] = SourceRange(lines.At(number, column), static_cast<std::uint32_t>(fields[f].size()));
       std::optional<double> value = ParseNumber(fields[f]);
       if (!value || !std::isfinite(*value)) {
-        diags.Report(DiagKind::CsvBadNumber, SourceRange(lines.At(number, column), static_cast<std::uint32_t>(fields[f].size())),
-                     Printable(fields[f]), kColumns[f], "");
+        diags.Report(DiagKind::CsvBadNumber, field_at[f], Printable(fields[f]), kColumns[f], "");
+        ok = false;
+      } else if (f < 4 && (*value != std::floor(*value) || *value < 1 || *value > bounds[f])) {
+        // Whole numbers within the plan's: never wrapped into an int.
+        diags.Report(DiagKind::MeasureLogBadInteger, field_at[f], Printable(fields[f]), kColumns[f], bounds[f]);
         ok = false;
       }
       values[f] = value.value_or(0);
@@ -207,22 +262,60 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
     reading.node = static_cast<int>(values[1]);
     reading.set = static_cast<int>(values[2]);
     reading.repetition = static_cast<int>(values[3]);
-    reading.at = Eigen::Vector2d(values[4], values[5]);
     reading.a = values[6];
     reading.b = values[7];
     reading.where = where;
-    auto visit = visits.find(reading.visit);
-    if (visit == visits.end() || visit->second->node != reading.node) {
+    const Visit& visit = visits[static_cast<std::size_t>(reading.visit - 1)];
+    if (visit.node != reading.node) {
       diags.Report(DiagKind::MeasureLogUnknownVisit, where, reading.visit, reading.node,
-                   visit == visits.end() ? fmt::format("{} visits", plan.plan.visits.size())
-                                         : fmt::format("node {} there", visit->second->node));
+                   fmt::format("node {} there", visit.node));
       continue;
     }
-    reading.axes = visit->second->axes;
-    reading.kind = visit->second->kind;
-    reading.at = visit->second->at;  // the plan's exact node (the log has 6 decimals)
+    // The rest of the line must be the plan's visit as the program logs it
+    // (the commanded position with 6 decimals).
+    const auto planned = [&](std::size_t f, std::string_view what, std::string theirs) {
+      diags.Report(DiagKind::MeasureLogNotPlanned, field_at[f], reading.visit, what, Printable(fields[f]),
+                   std::move(theirs));
+    };
+    if (reading.set != visit.set) {
+      planned(2, "set", std::to_string(visit.set));
+      continue;
+    }
+    if (reading.repetition > visit.repetitions) {
+      planned(3, "repetition", fmt::format("1 to {}", visit.repetitions));
+      continue;
+    }
+    constexpr double kLoggedPositionMm = 2e-6;  // "%.6f" of the plan's micrometres
+    if (std::abs(values[4] - visit.at.x()) > kLoggedPositionMm) {
+      planned(4, "x_mm", FormatMm(visit.at.x()));
+      continue;
+    }
+    if (std::abs(values[5] - visit.at.y()) > kLoggedPositionMm) {
+      planned(5, "y_mm", FormatMm(visit.at.y()));
+      continue;
+    }
+    if (reading.visit < block.first_visit || reading.visit > block.last_visit) {
+      Diagnostic* diag = diags.Report(DiagKind::MeasureLogOutsideRun, where, reading.visit, block.first_visit,
+                                      block.last_visit);
+      Diagnostics::AddNote(diag, block.header_range, "the run's header");
+      continue;
+    }
+    auto [seen, fresh] = in_block.try_emplace({reading.visit, reading.repetition}, number, log.readings.size());
+    if (!fresh) {
+      const Reading& first = log.readings[seen->second.second];
+      const bool same = first.a == reading.a && first.b == reading.b;
+      Diagnostic* diag = diags.Report(DiagKind::MeasureLogDuplicate, where, reading.visit, reading.repetition,
+                                      same ? "" : " with other readings", seen->second.first);
+      Diagnostics::AddNote(diag, first.where, "first logged here");
+      continue;
+    }
+    reading.axes = visit.axes;
+    reading.kind = visit.kind;
+    reading.at = visit.at;  // the plan's exact node (the log has 6 decimals)
     log.readings.push_back(reading);
     log.block_of.push_back(static_cast<int>(log.blocks.size()) - 1);
+    block.last_visit_logged = reading.visit;
+    block.last_repetition_logged = reading.repetition;
   }
   if (diags.error_count() != errors_before) return std::nullopt;
   return log;

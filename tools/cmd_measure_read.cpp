@@ -34,12 +34,16 @@ std::string BaseName(const std::string& path) { return std::filesystem::path(pat
 
 // The readings of the logs, given in order: a block's readings replace those
 // of earlier blocks for the visits it covers (a resumed run appends a block
-// that starts at the visit the abort named).
-std::vector<measure::Reading> MergeReadings(const std::vector<measure::MeasuringLog>& logs, int& replaced) {
+// that starts at the visit the abort named). A block's cut last line is an
+// error unless a later block measures its visit again.
+std::vector<measure::Reading> MergeReadings(const std::vector<measure::MeasuringLog>& logs, const std::string& plan,
+                                            int& replaced, Diagnostics& diags) {
   std::map<std::pair<int, int>, measure::Reading> by_key;  // (visit, repetition)
   replaced = 0;
-  for (const measure::MeasuringLog& log : logs) {
-    for (const measure::LogBlock& block : log.blocks) {
+  for (std::size_t l = 0; l < logs.size(); ++l) {
+    const measure::MeasuringLog& log = logs[l];
+    for (std::size_t b = 0; b < log.blocks.size(); ++b) {
+      const measure::LogBlock& block = log.blocks[b];
       for (auto it = by_key.begin(); it != by_key.end();) {
         if (it->first.first >= block.first_visit && it->first.first <= block.last_visit) {
           it = by_key.erase(it);
@@ -48,16 +52,52 @@ std::vector<measure::Reading> MergeReadings(const std::vector<measure::Measuring
           ++it;
         }
       }
-      const int index = static_cast<int>(&block - log.blocks.data());
       for (std::size_t k = 0; k < log.readings.size(); ++k) {
-        if (log.block_of[k] != index) continue;
+        if (log.block_of[k] != static_cast<int>(b)) continue;
         by_key[{log.readings[k].visit, log.readings[k].repetition}] = log.readings[k];
       }
+      if (!block.cut) continue;
+      // Measured again later?
+      const int visit = block.cut->visit;
+      bool again = false;
+      for (std::size_t l2 = l; l2 < logs.size() && !again; ++l2) {
+        for (std::size_t b2 = (l2 == l ? b + 1 : 0); b2 < logs[l2].blocks.size(); ++b2) {
+          const measure::LogBlock& later = logs[l2].blocks[b2];
+          again = again || (visit >= later.first_visit && visit <= later.last_visit);
+        }
+      }
+      if (again) continue;
+      const int resume = visit > 0 ? visit : std::max(block.first_visit, block.last_visit_logged);
+      diags.Report(DiagKind::MeasureLogCut, block.cut->where, Printable(BaseName(log.name)),
+                   visit > 0 ? fmt::format(" (visit {})", visit) : "", plan, resume);
     }
   }
   std::vector<measure::Reading> readings;
   for (auto& [key, reading] : by_key) readings.push_back(reading);
   return readings;
+}
+
+// What the logs say about a visit they lack: the run that should have
+// measured it and how it ended.
+std::string WhyMissing(const std::vector<measure::MeasuringLog>& logs, int visit) {
+  std::string why;
+  for (const measure::MeasuringLog& log : logs) {
+    for (const measure::LogBlock& block : log.blocks) {
+      if (visit < block.first_visit || visit > block.last_visit) continue;
+      if (!block.stopped.empty()) {
+        why = fmt::format(" ({} says: {})", BaseName(log.name), block.stopped);
+      } else if (!block.ended) {
+        why = fmt::format(" ({} stopped {} without a word: LinuxCNC stopped the program - its own error, an "
+                          "e-stop or a power cut; its error message says why)",
+                          BaseName(log.name),
+                          block.last_visit_logged > 0 ? fmt::format("after visit {} repetition {}",
+                                                                     block.last_visit_logged,
+                                                                     block.last_repetition_logged)
+                                                      : "before its first reading");
+      }
+    }
+  }
+  return why;
 }
 
 void RunRead(const ReadOptions& opt, GlobalOptions& options) {
@@ -109,7 +149,7 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
     return;
   }
   int replaced = 0;
-  std::vector<measure::Reading> all = MergeReadings(logs, replaced);
+  std::vector<measure::Reading> all = MergeReadings(logs, BaseName(opt.plan), replaced, diags);
   std::map<std::pair<int, int>, measure::Reading*> by_key;
   for (measure::Reading& reading : all) by_key[{reading.visit, reading.repetition}] = &reading;
   // Every reading the plan asks for in the region, in plan order.
@@ -125,32 +165,17 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
         continue;
       }
       if (!diags.has_errors()) {
-        std::string stopped;
-        for (const measure::MeasuringLog& log : logs) {
-          for (const measure::LogBlock& block : log.blocks) {
-            if (visit.number >= block.first_visit && visit.number <= block.last_visit && !block.stopped.empty()) {
-              stopped = fmt::format(" ({} says: {})", BaseName(log.name), block.stopped);
-            }
-          }
-        }
         diags.Report(DiagKind::MeasureLogIncomplete,
                      SourceRange(SourceLoc{plan_file, plan->lines[k], 1}), visit.number, visit.node, grid.name,
-                     FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set, rep, stopped, BaseName(opt.plan),
-                     visit.number);
+                     FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set, rep, WhyMissing(logs, visit.number),
+                     BaseName(opt.plan), visit.number);
       }
     }
   }
   const cell::Measure& device = *cell->measure;
-  if (device.device == cell::MeasureDevice::kTransducer) {
-    for (const measure::Reading& r : readings) {
-      for (double value : {r.a, r.b}) {
-        if (device.transducer.range_mm.Contains(value)) continue;
-        diags.Report(DiagKind::MeasureReadingOutOfRange, r.where, FormatMm(value), FormatMm(device.transducer.range_mm.lo),
-                     FormatMm(device.transducer.range_mm.hi), r.visit);
-        break;
-      }
-    }
-  }
+  // Every reading against what the device can give and against its node's
+  // others, before any correction spreads it.
+  if (!diags.has_errors()) measure::CheckReadings(device, cell->robot, readings, BaseName(opt.plan), diags);
   if (device.device == cell::MeasureDevice::kExternal) {
     if (opt.external.empty()) {
       options.exit_code =
@@ -171,6 +196,7 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
       }
       std::set<std::tuple<long long, long long, long long>> used;
       for (const measure::Reading& r : all) used.insert({r.node, r.set, r.repetition});
+      std::vector<SourceRange> external_where;
       for (measure::Reading& r : readings) {
         auto it = found.find({r.node, r.set, r.repetition});
         if (it == found.end()) {
@@ -179,11 +205,15 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
           continue;
         }
         r.external = it->second->at;
+        external_where.push_back(it->second->range);
       }
       for (const ExternalReading& e : *external) {
         if (!used.contains({e.node, e.set, e.repetition})) {
           diags.Report(DiagKind::MeasureExternalUnknown, e.range, e.node, e.set, e.repetition);
         }
+      }
+      if (!diags.has_errors()) {
+        measure::CheckExternalReadings(device, cell->robot, readings, external_where, BaseName(opt.plan), diags);
       }
     }
   }
