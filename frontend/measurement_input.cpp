@@ -123,6 +123,7 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
     visit.at = row.at;
     visit.set = row.set;
     visit.repetitions = row.repetitions;
+    visit.direction = row.direction;
     plan.visits.push_back(visit);
     loaded.lines.push_back(row.line);
   }
@@ -131,6 +132,39 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
     std::sort(region.ys.begin(), region.ys.end());
   }
   if (diags.error_count() != errors_before) return std::nullopt;
+  // The stations: where each placement of the artefact went (the box of
+  // its points), the regions it measured as nodes, and the stations it
+  // shares nodes with (ties).
+  std::map<int, std::size_t> station_of;
+  std::map<std::pair<int, MeasuredAxes>, std::set<int>> stations_of_node;
+  for (const Visit& v : plan.visits) {
+    auto [it, fresh] = station_of.try_emplace(v.station, plan.stations.size());
+    if (fresh) {
+      PlanStation station;
+      station.number = v.station;
+      station.axes = v.axes;
+      station.origin = station.far = v.at;
+      plan.stations.push_back(station);
+    }
+    PlanStation& station = plan.stations[it->second];
+    station.origin = station.origin.cwiseMin(v.at);
+    station.far = station.far.cwiseMax(v.at);
+    if ((v.kind == VisitKind::kNode || v.kind == VisitKind::kCheck) &&
+        std::find(station.regions.begin(), station.regions.end(), v.region) == station.regions.end()) {
+      station.regions.push_back(v.region);
+    }
+    if (v.kind == VisitKind::kTie && v.set == 1 && v.direction > 0) ++station.ties;
+    if (v.kind != VisitKind::kCheck) stations_of_node[{v.node, v.axes}].insert(v.station);
+  }
+  for (const auto& [node, stations] : stations_of_node) {
+    for (int a : stations) {
+      for (int b : stations) {
+        std::vector<int>& tied = plan.stations[station_of[a]].tied_to;
+        if (a != b && std::find(tied.begin(), tied.end(), b) == tied.end()) tied.push_back(b);
+      }
+    }
+  }
+  for (PlanStation& station : plan.stations) std::sort(station.tied_to.begin(), station.tied_to.end());
   return loaded;
 }
 
@@ -311,6 +345,9 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
     }
     reading.axes = visit.axes;
     reading.kind = visit.kind;
+    reading.region = visit.region;
+    reading.station = visit.station;
+    reading.direction = visit.direction;
     reading.at = visit.at;  // the plan's exact node (the log has 6 decimals)
     log.readings.push_back(reading);
     log.block_of.push_back(static_cast<int>(log.blocks.size()) - 1);
@@ -319,6 +356,118 @@ std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPla
   }
   if (diags.error_count() != errors_before) return std::nullopt;
   return log;
+}
+
+namespace {
+
+// One setting: its key in the log's header and the raw file's comment, its
+// value in the cell, and what it is.
+struct Setting {
+  std::string key;
+  std::string cell_value;
+  std::string_view what;
+};
+
+std::string Number(double v) { return fmt::format("{}", v); }
+
+std::vector<Setting> SettingsOf(const cell::Cell& cell) {
+  std::vector<Setting> out;
+  const Eigen::Vector2d a = cell.robot.final_approach_mm.value_or(Eigen::Vector2d::Zero());
+  out.push_back({"approach", Number(a.x()) + " " + Number(a.y()), "robot.final_approach_mm"});
+  if (!cell.measure) return out;
+  const cell::Measure& m = *cell.measure;
+  if (m.device == cell::MeasureDevice::kProbe) {
+    out.push_back({"hole_diameter_mm", Number(m.probe.hole_diameter_mm), "measure.probe.hole_diameter_mm"});
+    out.push_back({"stylus_diameter_mm", Number(m.probe.stylus_diameter_mm), "measure.probe.stylus_diameter_mm"});
+  } else if (m.device == cell::MeasureDevice::kTransducer) {
+    out.push_back({"slope", Number(m.transducer.slope), "measure.transducer.slope"});
+    out.push_back({"zero_mm", Number(m.transducer.zero_mm), "measure.transducer.zero_mm"});
+  }
+  return out;
+}
+
+// The same numbers, however written ("0.5 0.5" and "0.50 0.5").
+bool SameNumbers(std::string_view a, std::string_view b) {
+  auto split = [](std::string_view text) {
+    std::vector<std::optional<double>> values;
+    std::size_t at = 0;
+    while (at < text.size()) {
+      std::size_t end = text.find(' ', at);
+      if (end == std::string_view::npos) end = text.size();
+      if (end > at) values.push_back(ParseNumber(text.substr(at, end - at)));
+      at = end + 1;
+    }
+    return values;
+  };
+  const auto x = split(a), y = split(b);
+  if (x.size() != y.size()) return false;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (!x[k] || !y[k] || std::abs(*x[k] - *y[k]) > 1e-9 * std::max(1.0, std::abs(*y[k]))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void CheckLogSettings(const MeasuringLog& log, const cell::Cell& cell, Diagnostics& diags) {
+  for (const LogBlock& block : log.blocks) {
+    for (const Setting& setting : SettingsOf(cell)) {
+      const std::string logged = Item(block.header, setting.key);
+      if (logged.empty()) {
+        diags.Report(DiagKind::MeasureLogSettings, block.header_range,
+                     fmt::format("the log's header does not say the {} ({}) it was measured with: an older measuring "
+                                 "program wrote it; make the programs again (smtcal measure program)",
+                                 setting.key, setting.what));
+        break;
+      }
+      if (SameNumbers(logged, setting.cell_value)) continue;
+      diags.Report(DiagKind::MeasureLogSettings, block.header_range,
+                   fmt::format("the log was measured with {} {}, but the cell's {} is {} now: every error read with "
+                               "it would be off",
+                               setting.key, Printable(logged), setting.what, setting.cell_value));
+    }
+  }
+}
+
+std::string MeasuredWith(const cell::Cell& cell) {
+  std::string out = fmt::format(
+      "device {}", cell.measure ? cell::kMeasureDeviceNames[static_cast<std::size_t>(cell.measure->device)] : "none");
+  for (const Setting& setting : SettingsOf(cell)) out += fmt::format("; {} {}", setting.key, setting.cell_value);
+  return out;
+}
+
+void CheckRawSettings(std::uint32_t raw_file, const cell::Cell& cell, Diagnostics& diags) {
+  const cad::Lines lines(diags.sources(), raw_file);
+  for (std::uint32_t number = 1; number <= lines.count(); ++number) {
+    std::string_view line = lines.Text(number);
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
+    if (!line.starts_with(kMeasuredWithMark)) continue;
+    const SourceRange where(lines.At(number, 0), static_cast<std::uint32_t>(line.size()));
+    const std::string device = Item(line.substr(kMeasuredWithMark.size()), "device");
+    const std::string want =
+        cell.measure ? std::string(cell::kMeasureDeviceNames[static_cast<std::size_t>(cell.measure->device)]) : "none";
+    if (device != want) {
+      diags.Report(DiagKind::TableRawSettings, where,
+                   fmt::format("the raw measurements were taken with the device '{}', but cell '{}' measures with "
+                               "'{}'",
+                               Printable(device), Printable(cell.name), want));
+      return;
+    }
+    for (const Setting& setting : SettingsOf(cell)) {
+      const std::string raw = Item(line.substr(kMeasuredWithMark.size()), setting.key);
+      if (SameNumbers(raw, setting.cell_value)) continue;
+      diags.Report(DiagKind::TableRawSettings, where,
+                   fmt::format("the raw measurements were taken with {} {}, but cell '{}' says {} ({}): the table "
+                               "would be off by the difference",
+                               setting.key, raw.empty() ? "(not said)" : Printable(raw), Printable(cell.name),
+                               setting.cell_value, setting.what));
+    }
+    return;
+  }
+  diags.Report(DiagKind::TableRawSettings, SourceRange(SourceLoc{raw_file, 1, 1}),
+               fmt::format("the raw file does not say what it was measured with (a '# measured with:' line, which "
+                           "smtcal measure read writes), so it cannot be checked against cell '{}'",
+                           Printable(cell.name)));
 }
 
 }  // namespace smtcal::measure

@@ -70,4 +70,20 @@ struct MeasuringLog {
 // the caller (LogBlock::cut): a later block may measure the visit again.
 std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPlan& plan, Diagnostics& diags);
 
+// The settings a reading's meaning depends on (the final approach; the
+// probe's hole and stylus diameters; the transducer's slope and zero), as
+// the measuring program wrote them into each block's header, against the
+// cell's: a difference is an error at the header (MeasureLogSettings).
+void CheckLogSettings(const MeasuringLog& log, const cell::Cell& cell, Diagnostics& diags);
+
+// The same settings as "key value; key value" for the raw file's
+// "measured with:" comment, which `table build --cell` checks
+// (CheckRawSettings).
+std::string MeasuredWith(const cell::Cell& cell);
+inline constexpr std::string_view kMeasuredWithMark = "# measured with: ";
+// Reports (TableRawSettings, at the comment) each setting of the raw
+// file's "measured with:" comment that differs from `cell`'s, and a raw
+// file without that comment.
+void CheckRawSettings(std::uint32_t raw_file, const cell::Cell& cell, Diagnostics& diags);
+
 }  // namespace smtcal::measure

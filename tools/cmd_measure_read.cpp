@@ -14,6 +14,7 @@
 
 #include "backend/reports/measurement_csv.h"
 #include "base/field_text.h"
+#include "calibration/measurement_registration.h"
 #include "frontend/measurement_input.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
@@ -77,9 +78,44 @@ std::vector<measure::Reading> MergeReadings(const std::vector<measure::Measuring
   return readings;
 }
 
+// The stations whose readings the region's table needs: those that measured
+// its nodes and check points, and every station tied to them.
+std::set<int> StationsToRead(const measure::Plan& plan, std::size_t region) {
+  std::set<int> stations, frontier;
+  for (const measure::Visit& v : plan.visits) {
+    if (v.region == region && (v.kind == measure::VisitKind::kNode || v.kind == measure::VisitKind::kCheck)) {
+      frontier.insert(v.station);
+    }
+  }
+  while (!frontier.empty()) {
+    const int s = *frontier.begin();
+    frontier.erase(frontier.begin());
+    if (!stations.insert(s).second) continue;
+    for (const measure::PlanStation& station : plan.stations) {
+      if (station.number != s) continue;
+      for (int t : station.tied_to) {
+        if (!stations.contains(t)) frontier.insert(t);
+      }
+    }
+  }
+  return stations;
+}
+
 // What the logs say about a visit they lack: the run that should have
-// measured it and how it ended.
-std::string WhyMissing(const std::vector<measure::MeasuringLog>& logs, int visit) {
+// measured it and how it ended, or that no log given holds its station.
+std::string WhyMissing(const std::vector<measure::MeasuringLog>& logs, const measure::Visit& missing,
+                       const measure::Plan& plan, std::size_t region) {
+  const int visit = missing.number;
+  bool covered = false;
+  for (const measure::MeasuringLog& log : logs) {
+    for (const measure::LogBlock& block : log.blocks) covered = covered || (visit >= block.first_visit && visit <= block.last_visit);
+  }
+  if (!covered) {
+    return fmt::format(" (no log given holds station {}{}: give every log of the stations tied to region {}'s, "
+                       "in the order they ran)",
+                       missing.station, missing.region == region ? "" : ", whose ties register region's readings",
+                       plan.regions[region].name);
+  }
   std::string why;
   for (const measure::MeasuringLog& log : logs) {
     for (const measure::LogBlock& block : log.blocks) {
@@ -148,16 +184,20 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
+  for (const measure::MeasuringLog& log : logs) measure::CheckLogSettings(log, *cell, diags);
   int replaced = 0;
   std::vector<measure::Reading> all = MergeReadings(logs, BaseName(opt.plan), replaced, diags);
   std::map<std::pair<int, int>, measure::Reading*> by_key;
   for (measure::Reading& reading : all) by_key[{reading.visit, reading.repetition}] = &reading;
-  // Every reading the plan asks for in the region, in plan order.
+  const measure::Plan& the_plan = plan->plan;
+  // The stations the region's table needs: those that measured its nodes,
+  // and every station tied to them (the registration needs them all).
+  const std::set<int> needed = StationsToRead(the_plan, *region);
+  // Every reading of those stations, in plan order.
   std::vector<measure::Reading> readings;
-  std::string resume;
-  for (std::size_t k = 0; k < plan->plan.visits.size(); ++k) {
-    const measure::Visit& visit = plan->plan.visits[k];
-    if (visit.region != *region) continue;
+  for (std::size_t k = 0; k < the_plan.visits.size(); ++k) {
+    const measure::Visit& visit = the_plan.visits[k];
+    if (!needed.contains(visit.station)) continue;
     for (int rep = 1; rep <= visit.repetitions; ++rep) {
       auto it = by_key.find({visit.number, rep});
       if (it != by_key.end()) {
@@ -166,9 +206,9 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
       }
       if (!diags.has_errors()) {
         diags.Report(DiagKind::MeasureLogIncomplete,
-                     SourceRange(SourceLoc{plan_file, plan->lines[k], 1}), visit.number, visit.node, grid.name,
-                     FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set, rep, WhyMissing(logs, visit.number),
-                     BaseName(opt.plan), visit.number);
+                     SourceRange(SourceLoc{plan_file, plan->lines[k], 1}), visit.number, visit.node,
+                     the_plan.regions[visit.region].name, FormatMm(visit.at.x()), FormatMm(visit.at.y()), visit.set,
+                     rep, WhyMissing(logs, visit, the_plan, *region), BaseName(opt.plan), visit.number);
       }
     }
   }
@@ -221,21 +261,29 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
     options.exit_code = PrintDiagnostics(diags, options);
     return;
   }
-  std::vector<std::string> notes;
-  std::vector<measure::ReadingError> errors =
-      measure::ErrorsOfReadings(device, cell->robot, grid.xs, grid.ys, readings, notes);
+  // The errors as read in each placement, the closures, the registration.
+  measure::ReadOutcome outcome =
+      measure::RegisterReadings(*cell, the_plan, readings, BaseName(opt.plan), diags);
+  if (diags.has_errors()) {
+    options.exit_code = PrintDiagnostics(diags, options);
+    return;
+  }
   std::vector<RawMeasurement> rows;
   std::vector<bool> checks;
-  for (const measure::ReadingError& e : errors) {
+  for (const measure::RegisteredError& e : outcome.errors) {
+    const measure::Reading& r = readings[e.reading];
+    if (r.region != *region || (r.kind != measure::VisitKind::kNode && r.kind != measure::VisitKind::kCheck)) continue;
     RawMeasurement m;
     m.axis = e.axis;
-    m.x_mm = e.at.x();
-    m.y_mm = e.at.y();
-    m.set = e.set;
-    m.repetition = e.repetition;
+    m.x_mm = r.at.x();
+    m.y_mm = r.at.y();
+    m.set = r.set;
+    m.repetition = r.repetition;
     m.error_mm = e.error_mm;
+    m.u_mm = e.u_mm;
+    m.reverse = r.direction < 0;
     rows.push_back(m);
-    checks.push_back(e.kind == measure::VisitKind::kCheck);
+    checks.push_back(r.kind == measure::VisitKind::kCheck);
   }
   // Axis x first, then y, each in plan order (a stable sort keeps it).
   std::vector<std::size_t> order(rows.size());
@@ -253,6 +301,7 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
                                 grid.name, cell->name));
   comment.push_back(fmt::format("plan {} (digest {}); cell {}; device {}", BaseName(opt.plan), plan->digest,
                                 BaseName(opt.cell), cell::kMeasureDeviceNames[static_cast<std::size_t>(device.device)]));
+  comment.push_back(std::string(measure::kMeasuredWithMark.substr(2)) + measure::MeasuredWith(*cell));
   for (const measure::MeasuringLog& log : logs) {
     for (const measure::LogBlock& block : log.blocks) {
       comment.push_back(fmt::format("log {}: visits {}..{}{}", BaseName(log.name), block.first_visit, block.last_visit,
@@ -264,7 +313,8 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
     comment.push_back(fmt::format("{} reading{} of a stopped run replaced by the resumed run's", replaced,
                                   replaced == 1 ? "" : "s"));
   }
-  for (const std::string& note : notes) comment.push_back(note);
+  for (const std::string& note : outcome.notes) comment.push_back(note);
+  for (const std::string& line : measure::DescribeBudget(*cell, the_plan, outcome, *region, readings)) comment.push_back(line);
   comment.push_back(fmt::format("Build the table: smtcal table build {} -o TABLE.csv", BaseName(opt.output)));
   Status written = WriteFileAtomically(opt.output, FormatRawCsv(sorted, sorted_checks, comment));
   if (!written) {
@@ -273,8 +323,9 @@ void RunRead(const ReadOptions& opt, GlobalOptions& options) {
   }
   options.exit_code = PrintDiagnostics(diags, options);
   SayDone(options, opt.output,
-          fmt::format("wrote {} ({} readings of region {}{})", opt.output, readings.size(), grid.name,
-                      replaced > 0 ? fmt::format("; {} of a stopped run replaced", replaced) : ""));
+          fmt::format("wrote {} ({} readings of region {}{})", opt.output, rows.size() / (device.device ==
+                                                                    cell::MeasureDevice::kTransducer ? 1 : 2),
+                      grid.name, replaced > 0 ? fmt::format("; {} of a stopped run replaced", replaced) : ""));
 }
 
 }  // namespace
