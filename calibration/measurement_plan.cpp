@@ -296,8 +296,7 @@ std::vector<VisitGroup> GroupVisits(const std::vector<Visit>& visits) {
   std::vector<VisitGroup> groups;
   for (std::size_t k = 0; k < visits.size(); ++k) {
     const Visit& v = visits[k];
-    if (groups.empty() || groups.back().region != v.region || groups.back().axes != v.axes ||
-        groups.back().station != v.station) {
+    if (groups.empty() || groups.back().axes != v.axes || groups.back().station != v.station) {
       groups.push_back({v.region, v.axes, v.station, k, 0});
     }
     ++groups.back().count;
