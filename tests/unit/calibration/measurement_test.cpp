@@ -250,6 +250,11 @@ TEST(MeasurementPlan, StationsOfThePaperCellAreTied) {
                         std::count(station.regions.begin(), station.regions.end(), std::size_t{4}) == 1);
   }
   EXPECT_TRUE(shared);
+  // One measuring program per station (the probe measures x and y
+  // together): a station's regions never split it.
+  const std::vector<VisitGroup> groups = GroupVisits(plan->visits);
+  ASSERT_EQ(groups.size(), plan->stations.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) EXPECT_EQ(groups[g].station, static_cast<int>(g) + 1);
   // Every set of every station: its last visit is its first point again.
   std::map<int, std::vector<const Visit*>> of_station;
   for (const Visit& v : plan->visits) of_station[v.station].push_back(&v);
