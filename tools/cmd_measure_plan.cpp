@@ -92,7 +92,7 @@ void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options) {
   plan->add_flag("--no-check-points", opt.no_check_points,
                  "no check points between nodes (the interpolation error is then estimated from the table alone)");
   plan->add_flag("--bidirectional", opt.bidirectional,
-                 "ISO 230-2's bidirectional measurement: every point also approached (and probed) against the final\n"
+                 "the bidirectional measurement of ISO 230-2: every point also approached (and probed) against the final\n"
                  "approach; table build gives each node its reversal value (reversal_mm: the backlash)");
   plan->callback([&options] { RunPlan(opt, options); });
 }
