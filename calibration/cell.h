@@ -341,6 +341,9 @@ struct MeasureProbe {
   double stylus_diameter_mm = 0;  // the stylus ball's effective diameter (calibrated on a ring gauge)
   double speed_mm_s = 1;          // the probing feed
   double overtravel_mm = 0.5;     // how far past the expected wall a probe move may go before it is a miss
+  int holes = 0;                  // holes per direction: the plate reaches (holes - 1) x hole_pitch_mm; 0: not declared
+  double hole_diameter_u_mm = 0;    // the standard uncertainty of hole_diameter_mm (the plate's certificate)
+  double stylus_diameter_u_mm = 0;  // ... of stylus_diameter_mm (the ring gauge's calibration)
 };
 
 struct MeasureExternal {
@@ -359,6 +362,16 @@ struct Measure {
   double timeout_s = 5;   // how long the program waits for the device before it aborts
   double reading_time_s = 0;  // the device's own time per reading (an external system's exposure), for the plan's time
   std::optional<int> ready_input;  // motion.digital-in-NN, on while the device is ready (checked before each reading)
+  // How far off and how far turned the artefact may be put down at a set-up
+  // (the probing cycle's clearances; the registration of untied set-ups).
+  // Default: the robot's uncalibrated_accuracy_mm, and 0.1 degree.
+  std::optional<double> placement_mm;
+  double placement_deg = 0.1;
+  double u_deg = 0;  // the nozzle angle u the programs command before measuring
+  // The artefact's certificate: its pitch (scale) error, which measure read
+  // corrects, and the standard uncertainty of that, in parts per million.
+  double artefact_pitch_error_ppm = 0;
+  double artefact_pitch_u_ppm = 0;
   MeasureTransducer transducer;
   MeasureProbe probe;
   MeasureExternal external;

@@ -220,10 +220,12 @@ std::optional<AxisTable> AxisAssembly::Run() {
   AxisTable table;
   table.xs = xs;
   table.ys = ys;
-  bool any_stddev = false, any_count = false;
+  bool any_stddev = false, any_count = false, any_u = false, any_reversal = false;
   for (const auto& slot : at) {
     any_stddev = any_stddev || nodes[*slot].stddev_mm.has_value();
     any_count = any_count || nodes[*slot].count > 0;
+    any_u = any_u || nodes[*slot].u_mm.has_value();
+    any_reversal = any_reversal || nodes[*slot].reversal_mm.has_value();
   }
   for (const auto& slot : at) {
     const TableNode& node = nodes[*slot];
@@ -231,6 +233,8 @@ std::optional<AxisTable> AxisAssembly::Run() {
     table.origin.push_back(node.error_field);
     if (any_stddev) table.stddev_mm.push_back(node.stddev_mm);
     if (any_count) table.count.push_back(node.count);
+    if (any_u) table.u_mm.push_back(node.u_mm);
+    if (any_reversal) table.reversal_mm.push_back(node.reversal_mm);
   }
   return table;
 }
@@ -322,6 +326,8 @@ bool HasUsableShape(const ErrorTable& table) {
     if (t.error_mm.size() != t.nx() * t.ny()) return false;
     if (!t.stddev_mm.empty() && t.stddev_mm.size() != t.error_mm.size()) return false;
     if (!t.count.empty() && t.count.size() != t.error_mm.size()) return false;
+    if (!t.u_mm.empty() && t.u_mm.size() != t.error_mm.size()) return false;
+    if (!t.reversal_mm.empty() && t.reversal_mm.size() != t.error_mm.size()) return false;
     if (!t.origin.empty() && t.origin.size() != t.error_mm.size()) return false;
     // What keeps every slope, determinant and residual finite and accurate.
     auto length = [](double v) { return std::abs(v) <= kMaxLengthMm; };  // false for NaN

@@ -53,6 +53,13 @@ struct TableNode {
   double error_mm = 0;
   std::optional<double> stddev_mm;  // scatter of the measurements averaged
   int count = 0;                    // measurements averaged; 0 = not given
+  // The standard uncertainty of the value from everything but its own
+  // scatter (the artefact, the device's geometry, the registration of the
+  // artefact's set-ups: measure read's budget, docs/measure.md).
+  std::optional<double> u_mm;
+  // The reversal value (ISO 230-2): the error approached against the final
+  // approach less the error approached with it (a bidirectional plan).
+  std::optional<double> reversal_mm;
   SourceRange x_field;              // the fields in the file (unknown when built in code)
   SourceRange y_field;
   SourceRange error_field;
@@ -65,6 +72,8 @@ struct AxisTable {
   std::vector<double> error_mm;  // node (i, j) = (xs[i], ys[j]) at Index(i, j)
   std::vector<std::optional<double>> stddev_mm;  // empty, or one per node
   std::vector<int> count;                        // empty, or one per node (0 = not given)
+  std::vector<std::optional<double>> u_mm;         // empty, or one per node (TableNode::u_mm)
+  std::vector<std::optional<double>> reversal_mm;  // empty, or one per node (TableNode::reversal_mm)
   std::vector<SourceRange> origin;               // empty, or one per node: its value's field
   // Check points of this axis (kind = check): readings off the grid nodes,
   // each inside the grid's rectangle and away from the nodes

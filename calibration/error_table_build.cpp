@@ -16,20 +16,13 @@
 
 #include "base/check.h"
 #include "calibration/reading_screen.h"
+#include "calibration/statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
 namespace {
 
-constexpr double kMadToSigma = 1.4826;  // MAD of a normal distribution -> its sigma
 constexpr double kUmPerMm = 1000.0;
-
-double Median(std::vector<double> values) {
-  SMTCAL_CHECK(!values.empty(), "median of nothing");
-  std::sort(values.begin(), values.end());
-  std::size_t mid = values.size() / 2;
-  return values.size() % 2 == 1 ? values[mid] : 0.5 * (values[mid - 1] + values[mid]);
-}
 
 // "45-54, 166-175": the file lines of a node's measurements.
 std::string LineRanges(const std::vector<RawMeasurement>& measurements, const std::vector<std::size_t>& rows) {
@@ -336,9 +329,28 @@ std::vector<NodeSummary> SummarizeNodes(const std::vector<RawMeasurement>& measu
   return nodes;
 }
 
-std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& measurements,
+std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<RawMeasurement>& all,
                                           SourceLoc file, Diagnostics& diags, const BuildOptions& options) {
   std::size_t errors_before = diags.error_count();
+  // A bidirectional measurement: the table holds the errors approached as
+  // production approaches its targets; the readings against the approach
+  // give each node's reversal value (ISO 230-2), screened apart.
+  std::vector<RawMeasurement> measurements, reversed;
+  for (const RawMeasurement& m : all) (m.reverse ? reversed : measurements).push_back(m);
+  std::map<std::tuple<int, int, double, double>, double> reversed_mean;
+  if (!reversed.empty()) {
+    std::vector<NodeSummary> back = SummarizeNodes(reversed, diags);
+    if (diags.error_count() != errors_before) return std::nullopt;
+    const Screened screened_back = ScreenNodes(reversed, back, options.drop_outlier_readings, diags);
+    if (screened_back.undecided) return std::nullopt;
+    std::vector<RawMeasurement> kept_back;
+    for (std::size_t k = 0; k < reversed.size(); ++k) {
+      if (!screened_back.left_out[k]) kept_back.push_back(reversed[k]);
+    }
+    for (const NodeSummary& node : SummarizeNodes(kept_back, diags)) {
+      reversed_mean[{static_cast<int>(node.kind), static_cast<int>(node.axis), node.x_mm, node.y_mm}] = node.mean_mm;
+    }
+  }
   std::vector<NodeSummary> summaries = SummarizeNodes(measurements, diags);
   if (diags.error_count() != errors_before) return std::nullopt;
   const Screened screened = ScreenNodes(measurements, summaries, options.drop_outlier_readings, diags);
@@ -364,6 +376,12 @@ std::optional<ErrorTable> BuildErrorTable(std::string name, const std::vector<Ra
     node.error_mm = summary.mean_mm;
     node.stddev_mm = summary.stddev_mm;
     node.count = static_cast<int>(summary.rows.size());
+    for (std::size_t k : summary.rows) {
+      if (kept[k].u_mm) node.u_mm = std::max(node.u_mm.value_or(0.0), *kept[k].u_mm);
+    }
+    auto back = reversed_mean.find({static_cast<int>(summary.kind), static_cast<int>(summary.axis), summary.x_mm,
+                                    summary.y_mm});
+    if (back != reversed_mean.end()) node.reversal_mm = back->second - summary.mean_mm;
     node.x_field = first.x_field;
     node.y_field = first.y_field;
     node.error_field = first.error_field;

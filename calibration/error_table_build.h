@@ -28,6 +28,12 @@ struct RawMeasurement {
   long long set = 0;
   long long repetition = 0;
   double error_mm = 0;
+  // The optional u_mm column: the reading's standard uncertainty from
+  // everything but the scatter (measure read's budget; TableNode::u_mm).
+  std::optional<double> u_mm;
+  // The optional approach column: '-' for a reading approached against the
+  // final approach (a bidirectional plan: its difference is the reversal).
+  bool reverse = false;
   SourceRange x_field;  // for "node ... is here"
   SourceRange y_field;
   SourceRange repetition_field;
@@ -47,6 +53,8 @@ struct NodeSummary {
   // sqrt(1/n_low + 1/n_high): the spread's standard error per unit of
   // repetition scatter (given when there are two such sets and a pooled stddev).
   std::optional<double> set_spread_weight;
+  std::optional<double> u_mm;         // the largest of its readings'
+  std::optional<double> reversal_mm;  // mean of the reversed readings less the mean of the others
 };
 
 // Groups measurements by node (check points by position) and summarizes each

@@ -94,6 +94,15 @@ inline constexpr NumberRange kMeasureDwellS = Closed(0, 60, "s");
 inline constexpr NumberRange kTransducerSlope = Closed(-10, 10, "");
 inline constexpr NumberRange kTransducerGrooves = Whole(2, 10'000);
 inline constexpr NumberRange kExternalNodeOutput = Whole(0, 61);
+// [measure]: how far off and turned the artefact may be put down; its
+// certificate's pitch error and that error's uncertainty; the probe's
+// holes per direction; the diameters' standard uncertainties.
+inline constexpr NumberRange kPlacementMm = Closed(0, 10, "mm");
+inline constexpr NumberRange kPlacementDeg = Closed(0, 5, "deg");
+inline constexpr NumberRange kArtefactPitchPpm = Closed(-1000, 1000, "ppm");
+inline constexpr NumberRange kArtefactPitchUPpm = Closed(0, 1000, "ppm");
+inline constexpr NumberRange kProbeHoles = Whole(2, 10'000);
+inline constexpr NumberRange kDiameterUMm = Closed(0, 1, "mm");
 // smtcal measure: the grid pitch, sets x repetitions per node, the visit a
 // program resumes at.
 inline constexpr NumberRange kMeasurePitchMm = Closed(0.1, 1000, "mm");

@@ -5,6 +5,9 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numeric>
+#include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -35,13 +38,26 @@ double RoundPitchDown(double limit) {
 // bounds, and moved inside the robot's range `limit` when the centred grid
 // would reach past it (it still covers the bounds and the margin then,
 // unless the range itself is too short).
-std::vector<double> GridLines(const cell::Interval& bounds, double margin, double pitch, const cell::Interval& limit) {
+std::vector<double> GridLines(const cell::Interval& bounds, double margin, double pitch, const cell::Interval& limit,
+                              double lattice = 0) {
   const double span = bounds.hi - bounds.lo + 2 * margin;
-  const int cells = std::max(1, static_cast<int>(std::ceil(span / pitch - 1e-9)));
+  int cells = std::max(1, static_cast<int>(std::ceil(span / pitch - 1e-9)));
   double first = 0.5 * (bounds.lo + bounds.hi) - 0.5 * cells * pitch;
   first = std::min(first, bounds.lo - margin);  // rounding never uncovers the margin
-  if (first < limit.lo) first = std::min(limit.lo, bounds.lo - margin);
-  if (first + cells * pitch > limit.hi) first = std::max(limit.hi - cells * pitch, bounds.hi + margin - cells * pitch);
+  if (lattice > 0) {
+    // Down onto the lattice; one more cell when that uncovers the top.
+    first = std::floor(first / lattice + 1e-9) * lattice;
+    if (first + cells * pitch < bounds.hi + margin - 1e-9) ++cells;
+    // Inside the robot's range when that still covers the bounds and the
+    // margin (else the grid stays, and is reported).
+    const double inside_lo = std::ceil(limit.lo / lattice - 1e-9) * lattice;
+    if (first < limit.lo && inside_lo <= bounds.lo - margin + 1e-9) first = inside_lo;
+    const double inside_hi = std::floor((limit.hi - cells * pitch) / lattice + 1e-9) * lattice;
+    if (first + cells * pitch > limit.hi && inside_hi + cells * pitch >= bounds.hi + margin - 1e-9) first = inside_hi;
+  } else {
+    if (first < limit.lo) first = std::min(limit.lo, bounds.lo - margin);
+    if (first + cells * pitch > limit.hi) first = std::max(limit.hi - cells * pitch, bounds.hi + margin - cells * pitch);
+  }
   first = RoundUm(first);
   std::vector<double> lines;
   for (int i = 0; i <= cells; ++i) lines.push_back(RoundUm(first + i * pitch));
@@ -58,35 +74,128 @@ std::vector<std::size_t> CheckCells(std::size_t lines) {
   return cells;
 }
 
-// The index ranges [begin, end) of the lines one mounting of the plate
-// reaches: its grooves span (grooves - 1) groove pitches.
-std::vector<std::pair<std::size_t, std::size_t>> Stations(std::size_t lines, const cell::MeasureTransducer& plate,
-                                                          double pitch) {
+// The index ranges [begin, end) of the lines one placement of the artefact
+// reaches (`reach` mm; all of them without one), neighbours sharing one
+// line so the placements can be tied; spread evenly.
+std::vector<std::pair<std::size_t, std::size_t>> Chunks(std::size_t lines, std::optional<double> reach,
+                                                        double pitch) {
+  if (!reach) return {{0, lines}};
+  const std::size_t per = std::max<std::size_t>(2, static_cast<std::size_t>(std::floor(*reach / pitch + 1e-9)) + 1);
+  if (lines <= per) return {{0, lines}};
+  const std::size_t count = (lines - 1 + per - 2) / (per - 1);  // count (per - 1) + 1 >= lines
   std::vector<std::pair<std::size_t, std::size_t>> chunks;
-  const double reach = (plate.grooves - 1) * plate.groove_pitch_mm;
-  const std::size_t per = std::max<std::size_t>(2, static_cast<std::size_t>(std::floor(reach / pitch + 1e-9)) + 1);
-  const std::size_t count = (lines + per - 1) / per;
-  // Spread the lines evenly over the mountings.
-  std::size_t begin = 0;
   for (std::size_t k = 0; k < count; ++k) {
-    std::size_t size = (lines - begin) / (count - k);
-    chunks.push_back({begin, begin + size});
-    begin += size;
+    const std::size_t begin = k * (lines - 1) / count;
+    const std::size_t end = (k + 1) * (lines - 1) / count + 1;
+    chunks.push_back({begin, end});
   }
   return chunks;
 }
+
+constexpr double kPi = 3.14159265358979323846;
 
 struct PointOfRegion {
   Eigen::Vector2d at;
   VisitKind kind;
   int node;
+  std::size_t region = 0;
 };
+
+// An axis-aligned box of points.
+struct Box {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty = true;
+  Box Union(const Box& other) const {
+    if (empty) return other;
+    if (other.empty) return *this;
+    return {std::min(x0, other.x0), std::min(y0, other.y0), std::max(x1, other.x1), std::max(y1, other.y1), false};
+  }
+  Box With(const Eigen::Vector2d& p) const { return Union(Box{p.x(), p.y(), p.x(), p.y(), false}); }
+};
+
+Box BoxOf(const std::vector<PointOfRegion>& points) {
+  Box box;
+  for (const PointOfRegion& p : points) box = box.With(p.at);
+  return box;
+}
+
+// The plate reaches the box.
+bool Fits(const Box& box, double reach) { return box.x1 - box.x0 <= reach + 1e-9 && box.y1 - box.y0 <= reach + 1e-9; }
+
+// How far apart two boxes are (0 when they touch or overlap).
+double Gap(const Box& a, const Box& b) {
+  const double dx = std::max({0.0, a.x0 - b.x1, b.x0 - a.x1});
+  const double dy = std::max({0.0, a.y0 - b.y1, b.y0 - a.y1});
+  return std::hypot(dx, dy);
+}
+
+// The part of the region's points one placement measures.
+struct Piece {
+  std::size_t region = 0;
+  MeasuredAxes axes = MeasuredAxes::kXY;
+  std::vector<PointOfRegion> points;  // nodes, check points, and the line shared with the previous piece (ties)
+};
+
+struct StationBuild {
+  MeasuredAxes axes = MeasuredAxes::kXY;
+  std::vector<std::size_t> pieces;
+  std::vector<PointOfRegion> points;
+  std::set<int> tied_to;  // 0-based
+  Box Bounds() const { return BoxOf(points); }
+};
+
+// A line of one station's nodes that another measures to tie the two.
+struct TieLine {
+  std::vector<PointOfRegion> points;
+  double spread = 0;    // along the line: how well it fixes the turn
+  double distance = 0;  // from the measuring station's box
+  bool Better(const TieLine& other) const {
+    if (std::abs(spread - other.spread) > 1e-9) return spread > other.spread;
+    return distance < other.distance;
+  }
+};
+
+// The longest line (a column or a row) of `of`'s own nodes that `by` can
+// measure with its plate still reaching all its points; nullopt when none of
+// two nodes or more fits.
+std::optional<TieLine> BestTieLine(const StationBuild& by, const StationBuild& of, double reach) {
+  const Box box = by.Bounds();
+  std::optional<TieLine> best;
+  for (int axis = 0; axis < 2; ++axis) {  // 0: columns (x = c), 1: rows (y = c)
+    std::map<double, std::vector<PointOfRegion>> lines;
+    for (const PointOfRegion& p : of.points) {
+      if (p.kind == VisitKind::kNode) lines[p.at[axis]].push_back(p);
+    }
+    for (auto& [c, members] : lines) {
+      const int other = 1 - axis;
+      std::sort(members.begin(), members.end(),
+                [&](const PointOfRegion& a, const PointOfRegion& b) { return a.at[other] < b.at[other]; });
+      TieLine line;
+      Box grown = box;
+      for (const PointOfRegion& p : members) {
+        const Box with = grown.With(p.at);
+        if (!Fits(with, reach)) continue;
+        grown = with;
+        line.points.push_back(p);
+      }
+      if (line.points.size() < 2) continue;
+      line.spread = line.points.back().at[other] - line.points.front().at[other];
+      line.distance = Gap(box, BoxOf(line.points));
+      if (!best || line.Better(*best)) best = line;
+    }
+  }
+  return best;
+}
+
+// Micrometres up, for a bound in a message.
+std::string CeilUm(double mm) { return fmt::format("{}", std::ceil(mm * 1000 - 1e-9) / 1000); }
 
 // Serpentine order: rows by y, alternating x direction; every point is
 // reached by the same final approach, so the order only saves travel.
 void Serpentine(std::vector<PointOfRegion>& points) {
   std::sort(points.begin(), points.end(), [](const PointOfRegion& a, const PointOfRegion& b) {
-    return a.at.y() != b.at.y() ? a.at.y() < b.at.y() : a.at.x() < b.at.x();
+    if (a.at.y() != b.at.y()) return a.at.y() < b.at.y();
+    return a.at.x() != b.at.x() ? a.at.x() < b.at.x() : a.node < b.node;
   });
   std::size_t row = 0;
   for (std::size_t begin = 0; begin < points.size(); ++row) {
@@ -148,7 +257,15 @@ std::string_view MeasuredAxesName(MeasuredAxes axes) {
   return "xy";
 }
 
-std::string_view VisitKindName(VisitKind kind) { return kind == VisitKind::kNode ? "node" : "check"; }
+std::string_view VisitKindName(VisitKind kind) {
+  switch (kind) {
+    case VisitKind::kNode: return "node";
+    case VisitKind::kCheck: return "check";
+    case VisitKind::kTie: return "tie";
+    case VisitKind::kClosure: return "closure";
+  }
+  return "node";
+}
 
 double ProbeContactRadiusMm(const cell::MeasureProbe& probe) {
   return 0.5 * (probe.hole_diameter_mm - probe.stylus_diameter_mm);
@@ -163,8 +280,9 @@ double VisitTimeS(const cell::Cell& cell, const Visit& visit, const Visit* previ
   // One repetition: down, dwell, read, up, back to the approach point and in again.
   double device = 0;
   if (m.device == cell::MeasureDevice::kProbe) {
-    // Per axis: to the slow start, the probe move, back to the approach point and in.
-    const double slow = 2 * m.probe.overtravel_mm;
+    // Per axis: to the slow start, the probe move to the wall (where it is
+    // expected: overtravel_mm on), back to the approach point and in.
+    const double slow = m.probe.overtravel_mm;
     const double rapid = ProbeContactRadiusMm(m.probe) - m.probe.overtravel_mm;
     device = 2 * (xy(rapid) + slow / m.probe.speed_mm_s + xy(rapid + slow) + xy(approach.norm()));
   }
@@ -178,8 +296,7 @@ std::vector<VisitGroup> GroupVisits(const std::vector<Visit>& visits) {
   std::vector<VisitGroup> groups;
   for (std::size_t k = 0; k < visits.size(); ++k) {
     const Visit& v = visits[k];
-    if (groups.empty() || groups.back().region != v.region || groups.back().axes != v.axes ||
-        groups.back().station != v.station) {
+    if (groups.empty() || groups.back().axes != v.axes || groups.back().station != v.station) {
       groups.push_back({v.region, v.axes, v.station, k, 0});
     }
     ++groups.back().count;
@@ -209,14 +326,6 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
     plan.notes.push_back(fmt::format(
         "the robot's uncalibrated_accuracy_mm is not declared: the plan assumes {} mm for its margins and pitch",
         kPlanAssumedAccuracyMm));
-  }
-  if (m.device == cell::MeasureDevice::kProbe) {
-    const double room = ProbeContactRadiusMm(m.probe);
-    if (room <= plan.approach_mm.norm() + accuracy + m.probe.overtravel_mm) {
-      diags.Report(DiagKind::MeasureProbeHoleTooSmall, m.range, Mm(room), Mm(plan.approach_mm.norm()), Mm(accuracy),
-                   Mm(m.probe.overtravel_mm));
-      return std::nullopt;
-    }
   }
 
   // The regions: the cell's, and those its markers lack.
@@ -263,6 +372,7 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
 
   const std::size_t errors_before = diags.error_count();
   int next_node = 1;
+  std::vector<Piece> pieces;
   for (std::size_t c : chosen) {
     PlanRegion region = candidates[c];
     const cell::Region* source = sources[c];
@@ -340,8 +450,12 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
       usable[static_cast<std::size_t>(axis)] = {limit.lo + std::max(a, 0.0) + (a < 0 ? reach : 0.0),
                                                 limit.hi + std::min(a, 0.0) - (a > 0 ? reach : 0.0)};
     }
-    region.xs = GridLines(region.x_mm, region.margin_mm, region.pitch_mm, usable[0]);
-    region.ys = GridLines(region.y_mm, region.margin_mm, region.pitch_mm, usable[1]);
+    // The probe's grids lie on one lattice of the plate's holes (multiples
+    // of the hole pitch), so one placement of the plate can hold the nodes
+    // of several regions, and a station can measure its neighbour's.
+    const double snap = m.device == cell::MeasureDevice::kProbe ? m.probe.hole_pitch_mm : 0.0;  // 0: no lattice
+    region.xs = GridLines(region.x_mm, region.margin_mm, region.pitch_mm, usable[0], snap);
+    region.ys = GridLines(region.y_mm, region.margin_mm, region.pitch_mm, usable[1], snap);
     for (int axis = 0; axis < 2; ++axis) {
       const std::vector<double>& lines = axis == 0 ? region.xs : region.ys;
       const cell::Interval& limit = usable[static_cast<std::size_t>(axis)];
@@ -353,38 +467,43 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
     }
     if (diags.error_count() != errors_before) continue;
 
-    // The points: nodes numbered row by row, then the check points.
+    // The points: nodes numbered row by row, then the check points; the
+    // pieces one placement of the artefact holds.
     std::vector<PointOfRegion> nodes;
     for (double y : region.ys) {
       for (double x : region.xs) nodes.push_back({Eigen::Vector2d(x, y), VisitKind::kNode, next_node++});
     }
     region.nodes = static_cast<int>(nodes.size());
-    std::vector<MeasuredAxes> runs;
+    const std::vector<MeasuredAxes> runs = m.device == cell::MeasureDevice::kTransducer
+                                               ? std::vector<MeasuredAxes>{MeasuredAxes::kX, MeasuredAxes::kY}
+                                               : std::vector<MeasuredAxes>{MeasuredAxes::kXY};
+    // The lines one placement reaches: the transducer's grooves, the
+    // probe's holes when the plate's size is declared.
+    std::optional<double> reach_mm;
     if (m.device == cell::MeasureDevice::kTransducer) {
-      runs = {MeasuredAxes::kX, MeasuredAxes::kY};
-    } else {
-      runs = {MeasuredAxes::kXY};
+      reach_mm = (m.transducer.grooves - 1) * m.transducer.groove_pitch_mm;
+    } else if (m.device == cell::MeasureDevice::kProbe && m.probe.holes > 0) {
+      reach_mm = (m.probe.holes - 1) * m.probe.hole_pitch_mm;
     }
-    const auto x_stations = m.device == cell::MeasureDevice::kTransducer
-                                ? Stations(region.xs.size(), m.transducer, region.pitch_mm)
-                                : std::vector<std::pair<std::size_t, std::size_t>>{{0, region.xs.size()}};
-    const auto y_stations = m.device == cell::MeasureDevice::kTransducer
-                                ? Stations(region.ys.size(), m.transducer, region.pitch_mm)
-                                : std::vector<std::pair<std::size_t, std::size_t>>{{0, region.ys.size()}};
-    region.stations = static_cast<int>(x_stations.size() * y_stations.size());
+    const auto x_chunks = Chunks(region.xs.size(), reach_mm, region.pitch_mm);
+    const auto y_chunks = Chunks(region.ys.size(), reach_mm, region.pitch_mm);
+    const std::size_t region_index = plan.regions.size();
     for (MeasuredAxes run : runs) {
-      int station = 0;
       int checks = 0;
-      for (const auto& [y0, y1] : y_stations) {
-        for (const auto& [x0, x1] : x_stations) {
-          ++station;
-          std::vector<PointOfRegion> points;
+      std::set<int> home;  // nodes already measured as nodes in an earlier piece of this run
+      for (const auto& [y0, y1] : y_chunks) {
+        for (const auto& [x0, x1] : x_chunks) {
+          Piece piece;
+          piece.region = region_index;
+          piece.axes = run;
           for (const PointOfRegion& node : nodes) {
             const auto i = static_cast<std::size_t>(std::find(region.xs.begin(), region.xs.end(), node.at.x()) -
                                                     region.xs.begin());
             const auto j = static_cast<std::size_t>(std::find(region.ys.begin(), region.ys.end(), node.at.y()) -
                                                     region.ys.begin());
-            if (i >= x0 && i < x1 && j >= y0 && j < y1) points.push_back(node);
+            if (i < x0 || i >= x1 || j < y0 || j >= y1) continue;
+            const bool fresh = home.insert(node.node).second;
+            piece.points.push_back({node.at, fresh ? VisitKind::kNode : VisitKind::kTie, node.node, region_index});
           }
           if (options.check_points && centres_on_holes) {
             // Probe and external: cell centres. Transducer: on a groove of
@@ -399,27 +518,13 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
                 double y = 0.5 * (region.ys[j] + region.ys[j + 1]);
                 if (run == MeasuredAxes::kX) x = region.xs[i + 1];
                 if (run == MeasuredAxes::kY) y = region.ys[j + 1];
-                points.push_back({Eigen::Vector2d(RoundUm(x), RoundUm(y)), VisitKind::kCheck, next_node++});
+                piece.points.push_back({Eigen::Vector2d(RoundUm(x), RoundUm(y)), VisitKind::kCheck, next_node++,
+                                        region_index});
                 ++checks;
               }
             }
           }
-          Serpentine(points);
-          for (int set = 1; set <= options.sets; ++set) {
-            for (const PointOfRegion& point : points) {
-              Visit visit;
-              visit.number = static_cast<int>(plan.visits.size()) + 1;
-              visit.region = plan.regions.size();
-              visit.axes = run;
-              visit.station = station;
-              visit.kind = point.kind;
-              visit.node = point.node;
-              visit.at = point.at;
-              visit.set = set;
-              visit.repetitions = options.repetitions;
-              plan.visits.push_back(visit);
-            }
-          }
+          pieces.push_back(std::move(piece));
         }
       }
       region.check_points = std::max(region.check_points, checks);
@@ -427,6 +532,196 @@ std::optional<Plan> MakePlan(const cell::Cell& cell, const PlanOptions& options,
     plan.regions.push_back(std::move(region));
   }
   if (diags.error_count() != errors_before) return std::nullopt;
+
+  // The stations: one placement of the artefact each. The probe's plate,
+  // when its size is declared, holds every piece whose points fit on it
+  // together; otherwise each piece is a station of its own.
+  std::optional<double> plate_reach;
+  if (m.device == cell::MeasureDevice::kProbe && m.probe.holes > 0) {
+    plate_reach = (m.probe.holes - 1) * m.probe.hole_pitch_mm;
+  }
+  std::vector<StationBuild> stations;
+  for (const Piece& piece : pieces) {
+    StationBuild* into = nullptr;
+    if (plate_reach) {
+      for (StationBuild& station : stations) {
+        const bool same_region = std::any_of(station.pieces.begin(), station.pieces.end(), [&](std::size_t p) {
+          return pieces[p].region == piece.region;
+        });
+        if (!same_region && station.axes == piece.axes && Fits(station.Bounds().Union(BoxOf(piece.points)), *plate_reach)) {
+          into = &station;
+          break;
+        }
+      }
+    }
+    if (into == nullptr) {
+      stations.emplace_back();
+      into = &stations.back();
+      into->axes = piece.axes;
+    }
+    into->pieces.push_back(static_cast<std::size_t>(&piece - pieces.data()));
+    for (const PointOfRegion& point : piece.points) into->points.push_back(point);
+  }
+  // Ties: stations that share a node are tied; then, nearest pairs first,
+  // a station not yet tied to another measures a line of the other's nodes
+  // (or the other way round) when it still fits on the plate.
+  std::vector<int> parent(stations.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
+    return i;
+  };
+  auto join = [&](std::size_t a, std::size_t b) {
+    parent[static_cast<std::size_t>(find(static_cast<int>(a)))] = find(static_cast<int>(b));
+    stations[a].tied_to.insert(static_cast<int>(b));
+    stations[b].tied_to.insert(static_cast<int>(a));
+  };
+  if (m.device != cell::MeasureDevice::kExternal) {
+    std::map<std::pair<int, MeasuredAxes>, std::size_t> home_of;  // node -> its station
+    for (std::size_t s = 0; s < stations.size(); ++s) {
+      for (const PointOfRegion& p : stations[s].points) {
+        if (p.kind != VisitKind::kTie) home_of.try_emplace({p.node, stations[s].axes}, s);
+      }
+    }
+    for (std::size_t s = 0; s < stations.size(); ++s) {
+      for (const PointOfRegion& p : stations[s].points) {
+        if (p.kind != VisitKind::kTie) continue;
+        auto it = home_of.find({p.node, stations[s].axes});
+        if (it != home_of.end() && it->second != s) join(s, it->second);
+      }
+    }
+  }
+  if (plate_reach) {
+    std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+    for (std::size_t a = 0; a < stations.size(); ++a) {
+      for (std::size_t b = a + 1; b < stations.size(); ++b) pairs.emplace_back(Gap(stations[a].Bounds(), stations[b].Bounds()), a, b);
+    }
+    std::sort(pairs.begin(), pairs.end());
+    for (const auto& [gap, a, b] : pairs) {
+      if (find(static_cast<int>(a)) == find(static_cast<int>(b))) continue;
+      std::optional<TieLine> best;
+      std::size_t measurer = a, measured = b;
+      for (const auto& [by, of] : {std::pair{b, a}, std::pair{a, b}}) {
+        std::optional<TieLine> line = BestTieLine(stations[by], stations[of], *plate_reach);
+        if (line && (!best || line->Better(*best))) {
+          best = line;
+          measurer = by;
+          measured = of;
+        }
+      }
+      if (!best) continue;
+      for (PointOfRegion p : best->points) {
+        p.kind = VisitKind::kTie;
+        stations[measurer].points.push_back(p);
+      }
+      join(measurer, measured);
+    }
+  }
+  // The groups of stations the ties join.
+  std::map<int, int> groups;
+  for (std::size_t s = 0; s < stations.size(); ++s) groups.try_emplace(find(static_cast<int>(s)), 0);
+  if (groups.size() > 1 && m.device != cell::MeasureDevice::kExternal) {
+    plan.notes.push_back(fmt::format(
+        "the {} stations fall into {} groups that no tie joins{}: the artefact's placement relative to each other "
+        "is not measured between them, so measure read carries it ({} mm, {} degree) in every table's registration "
+        "uncertainty",
+        stations.size(), groups.size(),
+        m.device == cell::MeasureDevice::kProbe && m.probe.holes == 0
+            ? " (declare the plate's size, [measure.probe] holes, so the plan can put several regions on one "
+              "placement and tie the placements)"
+            : m.device == cell::MeasureDevice::kTransducer
+                  ? " (the grooved plate is mounted apart for x and y and for each region)"
+                  : " (the plate cannot reach from one to the other)",
+        Mm(m.placement_mm.value_or(accuracy)), Mm(m.placement_deg)));
+  }
+
+  // Each station: where the artefact goes, and how far a wall may be off.
+  double worst_reach = 0, worst_extent = 0;
+  for (std::size_t s = 0; s < stations.size(); ++s) {
+    StationBuild& build = stations[s];
+    // A point measured twice in one station (a tie that is also a node of
+    // a region merged here) is measured once, as the node.
+    std::stable_sort(build.points.begin(), build.points.end(), [](const PointOfRegion& a, const PointOfRegion& b) {
+      return a.node != b.node ? a.node < b.node : a.kind < b.kind;
+    });
+    build.points.erase(std::unique(build.points.begin(), build.points.end(),
+                                   [](const PointOfRegion& a, const PointOfRegion& b) { return a.node == b.node; }),
+                       build.points.end());
+    Serpentine(build.points);
+    PlanStation station;
+    station.number = static_cast<int>(s) + 1;
+    station.axes = build.axes;
+    for (std::size_t p : build.pieces) {
+      if (std::find(station.regions.begin(), station.regions.end(), pieces[p].region) == station.regions.end()) {
+        station.regions.push_back(pieces[p].region);
+      }
+    }
+    const Box box = build.Bounds();
+    station.origin = Eigen::Vector2d(box.x0, box.y0);
+    station.far = Eigen::Vector2d(box.x1, box.y1);
+    for (int t : build.tied_to) station.tied_to.push_back(t + 1);
+    for (const PointOfRegion& p : build.points) station.ties += p.kind == VisitKind::kTie ? 1 : 0;
+    const double extent = (station.far - station.origin).norm();
+    worst_extent = std::max(worst_extent, extent);
+    plan.stations.push_back(station);
+  }
+  for (PlanRegion& region : plan.regions) {
+    region.stations = 0;
+    for (const PlanStation& station : plan.stations) {
+      region.stations += static_cast<int>(std::count(station.regions.begin(), station.regions.end(),
+                                                      static_cast<std::size_t>(&region - plan.regions.data())));
+    }
+  }
+  if (m.device == cell::MeasureDevice::kProbe) {
+    // The probing cycle's clearances: a wall may lie the robot's error,
+    // the plate's placement and its turn over the station away from where
+    // it is expected.
+    const double placement = m.placement_mm.value_or(accuracy);
+    const double turn = m.placement_deg * kPi / 180 * worst_extent;
+    worst_reach = accuracy + placement + turn;
+    plan.probe_reach_mm = worst_reach;
+    const double over_needed = worst_reach + kProbeSafetyMarginMm;
+    if (m.probe.overtravel_mm < over_needed - 1e-9) {
+      diags.Report(DiagKind::MeasureOvertravelTooSmall, m.range, Mm(m.probe.overtravel_mm), CeilUm(over_needed),
+                   CeilUm(worst_reach), Mm(accuracy), Mm(placement), Mm(m.placement_deg), Mm(worst_extent),
+                   Mm(kProbeSafetyMarginMm), CeilUm(over_needed));
+    }
+    const double room = ProbeContactRadiusMm(m.probe);
+    const double room_needed = plan.approach_mm.norm() + worst_reach + kProbeSafetyMarginMm;
+    if (room <= room_needed) {
+      diags.Report(DiagKind::MeasureProbeHoleTooSmall, m.range, Mm(room), CeilUm(room_needed),
+                   Mm(plan.approach_mm.norm()), CeilUm(worst_reach), Mm(kProbeSafetyMarginMm));
+    }
+    if (diags.error_count() != errors_before) return std::nullopt;
+  }
+
+  // The visits: station by station, set by set, each set closed by the
+  // station's first point again.
+  for (std::size_t s = 0; s < stations.size(); ++s) {
+    const std::vector<PointOfRegion>& points = stations[s].points;
+    for (int set = 1; set <= options.sets; ++set) {
+      auto add = [&](const PointOfRegion& point, VisitKind kind, int direction) {
+        Visit visit;
+        visit.number = static_cast<int>(plan.visits.size()) + 1;
+        visit.region = point.region;
+        visit.axes = stations[s].axes;
+        visit.station = static_cast<int>(s) + 1;
+        visit.kind = kind;
+        visit.node = point.node;
+        visit.at = point.at;
+        visit.set = set;
+        visit.repetitions = options.repetitions;
+        visit.direction = direction;
+        plan.visits.push_back(visit);
+      };
+      for (const PointOfRegion& point : points) {
+        add(point, point.kind, 1);
+        if (options.bidirectional) add(point, point.kind, -1);
+      }
+      // An external system measures in the robot's frame: no artefact to move.
+      if (m.device != cell::MeasureDevice::kExternal) add(points.front(), VisitKind::kClosure, 1);
+    }
+  }
   const Visit* previous = nullptr;
   for (const Visit& visit : plan.visits) {
     const double t = VisitTimeS(cell, visit, previous);

@@ -30,8 +30,13 @@ namespace smtcal::measure {
 enum class MeasuredAxes { kX, kY, kXY };
 std::string_view MeasuredAxesName(MeasuredAxes axes);  // x | y | xy
 
-enum class VisitKind { kNode, kCheck };
-std::string_view VisitKindName(VisitKind kind);  // node | check
+// What a visit is for: a node of its region's table; a check point
+// between the nodes; a tie (a node of another station's region measured
+// here too, so the two placements of the artefact can be registered to
+// each other); a closure (the station's first point again at the end of a
+// set: a plate that moved during the set reads differently).
+enum class VisitKind { kNode, kCheck, kTie, kClosure };
+std::string_view VisitKindName(VisitKind kind);  // node | check | tie | closure
 
 // The default pitch (without --pitch) comes from the interpolation-error
 // estimate verify budgets (calibration/interpolation_error.h), the pitch at
@@ -46,6 +51,15 @@ inline constexpr double kPlanSmallestPitchMm = 0.1;
 // Without robot.uncalibrated_accuracy_mm the plan assumes this error (the
 // paper's robot after its gripper was mounted) and says so.
 inline constexpr double kPlanAssumedAccuracyMm = 0.25;
+// The probing cycle's margin beyond what the cell declares: a probe move
+// starts at least the robot's error, the artefact's placement and turn and
+// this far short of the wall it expects, and a stylus never comes closer
+// to a wall than this outside a probe move.
+inline constexpr double kProbeSafetyMarginMm = 0.05;
+// A plate moved when its closure visit reads this far or more from the
+// set's first reading of the same point (and beyond the readings' noise):
+// the probe reads in steps of a servo period's travel.
+inline constexpr double kPlateMovedFloorMm = 0.005;
 
 struct PlanRegion {
   std::string name;
@@ -62,8 +76,25 @@ struct PlanRegion {
   int repetitions = 0;
   int nodes = 0;         // grid nodes
   int check_points = 0;  // per measured axis: check points (x and y may differ for the transducer)
-  int stations = 1;      // transducer: the plate is mounted this many times per axis
+  int stations = 1;      // the placements of the artefact (stations) that hold its nodes
   double time_s = 0;     // the visits of this region at the cell's speeds
+};
+
+// One placement of the artefact: the stations are numbered 1, 2, ... in
+// plan order; each is one measuring program (the transducer: per axis).
+// Its visits measure the nodes (and check points) of one or more regions,
+// and as ties nodes of the stations it is tied to.
+struct PlanStation {
+  int number = 0;
+  MeasuredAxes axes = MeasuredAxes::kXY;
+  std::vector<std::size_t> regions;  // whose nodes it measures as nodes, into Plan::regions
+  // Where the artefact goes: its reference (the probe's corner hole, the
+  // transducer's first groove) at `origin`, covering the box from there to
+  // `far` (every point the station measures).
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  Eigen::Vector2d far = Eigen::Vector2d::Zero();
+  std::vector<int> tied_to;  // stations whose nodes it measures (or shares), ascending
+  int ties = 0;              // tie points it measures
 };
 
 struct Visit {
@@ -76,6 +107,7 @@ struct Visit {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();  // the commanded position (robot base, mm)
   int set = 1;             // 1-based
   int repetitions = 1;
+  int direction = 1;       // +1: reached by the final approach; -1: against it (a bidirectional plan)
 };
 
 struct Plan {
@@ -83,8 +115,13 @@ struct Plan {
   cell::MeasureDevice device = cell::MeasureDevice::kProbe;
   Eigen::Vector2d approach_mm = Eigen::Vector2d::Zero();  // robot.final_approach_mm
   std::vector<PlanRegion> regions;
+  std::vector<PlanStation> stations;
   std::vector<Visit> visits;
   double time_s = 0;
+  // How far a wall may lie from where a probe move expects it: the robot's
+  // error, the artefact's placement and its turn over the largest station
+  // (0 for other devices).
+  double probe_reach_mm = 0;
   std::vector<std::string> notes;  // what the plan assumed or could not do, for the summary
 };
 
@@ -94,6 +131,9 @@ struct PlanOptions {
   int sets = 2;          // the paper's
   int repetitions = 10;  // the paper's
   bool check_points = true;
+  // ISO 230-2's bidirectional measurement: every node also approached
+  // against the final approach, for its reversal value (the backlash).
+  bool bidirectional = false;
 };
 
 // The plan for `cell`. Reports (at the cell's keys): no [measure] table, no
@@ -110,8 +150,8 @@ double VisitTimeS(const cell::Cell& cell, const Visit& visit, const Visit* previ
 // The effective radius of the probe's holes: hole minus stylus, halved.
 double ProbeContactRadiusMm(const cell::MeasureProbe& probe);
 
-// The groups of visits one program measures: one region, one axis (x, y or
-// both), one station of the plate, in plan order.
+// The groups of visits one program measures: one station of the artefact,
+// one axis (x, y or both), in plan order (`region`: its first visit's).
 struct VisitGroup {
   std::size_t region = 0;
   MeasuredAxes axes = MeasuredAxes::kXY;

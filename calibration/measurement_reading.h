@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "base/diagnostics.h"
 #include "calibration/cell.h"
 #include "calibration/error_table.h"
 #include "calibration/measurement_plan.h"
@@ -34,6 +35,9 @@ struct Reading {
   int node = 0;
   int set = 1;
   int repetition = 1;
+  std::size_t region = 0;  // the node's region, into Plan::regions
+  int station = 1;         // the placement of the artefact it was read in
+  int direction = 1;       // +1: reached by the final approach; -1: against it
   MeasuredAxes axes = MeasuredAxes::kXY;
   VisitKind kind = VisitKind::kNode;
   Eigen::Vector2d at = Eigen::Vector2d::Zero();  // the node, commanded
@@ -51,15 +55,47 @@ struct ReadingError {
   int repetition = 1;
   double error_mm = 0;
   SourceRange where;
+  std::size_t reading = 0;  // index into the readings
 };
 
-// The errors of `readings`, all of one region whose grid lines are `xs`,
-// `ys`, measured by `measure` with the robot's final approach and servo
-// period. For the probe `notes` gets how far the largest trip lay from its
-// node and how much moving it there changed the error.
+// The errors of `readings` (of the regions `regions`, whose grids move the
+// probe's trips to their nodes), measured by `measure` with the robot's
+// final approach and servo period, as read in their own placement of the
+// artefact (not registered). `registered[k]` is what registration adds to
+// reading k's error (the artefact's displacement at its node, zero
+// before registering): the probe's field, which moves each trip to its
+// node, is built from registered errors, so placements that differ do not
+// bend it. For the probe `notes` gets how far the largest trip lay from
+// its node and how much moving it there changed the error.
 std::vector<ReadingError> ErrorsOfReadings(const cell::Measure& measure, const cell::Robot& robot,
-                                           const std::vector<double>& xs, const std::vector<double>& ys,
-                                           const std::vector<Reading>& readings, std::vector<std::string>& notes);
+                                           const std::vector<PlanRegion>& regions,
+                                           const std::vector<Reading>& readings,
+                                           const std::vector<Eigen::Vector2d>& registered,
+                                           std::vector<std::string>& notes);
+
+// Every reading checked against what its device can give and against its
+// node's other readings, before any is turned into an error at its node
+// (the probe's correction spreads each reading to its neighbours):
+//   - the probe: each trip within the probe move the program commands
+//     (from the node plus the contact radius less overtravel_mm to as far
+//     past it, late by up to one servo period of travel); the transducer:
+//     both readings within range_mm; the external system: the log holds
+//     0,0 (its readings come from the system's file: CheckExternalReadings);
+//   - a reading far from the others of its node (calibration/
+//     reading_screen.h on what the device read: the trip's distance from
+//     the node, the transducers' difference) is an error at its log line.
+// `plan_name` names the plan in the messages' resume command.
+void CheckReadings(const cell::Measure& measure, const cell::Robot& robot, const std::vector<Reading>& readings,
+                   std::string_view plan_name, Diagnostics& diags);
+
+// The external system's positions: a position farther from its node than
+// twice the robot's declared error (robot.uncalibrated_accuracy_mm, else
+// kPlanAssumedAccuracyMm) cannot be the robot's; `where` per reading is the
+// external file's line. Then the same screening against the node's other
+// readings as CheckReadings.
+void CheckExternalReadings(const cell::Measure& measure, const cell::Robot& robot,
+                           const std::vector<Reading>& readings, const std::vector<SourceRange>& where,
+                           std::string_view plan_name, Diagnostics& diags);
 
 // The plan file's digest (a 64-bit FNV-1a hash of its bytes with the
 // project's constants, 16 hex digits): the

@@ -85,12 +85,12 @@ std::string_view ErrorSourceDescription(ErrorSource source) {
   switch (source) {
     case ErrorSource::kResidual: return "the inverse's residual";
     case ErrorSource::kRepeatability: return "the robot's repeatability";
-    case ErrorSource::kTable: return "the table's measurement noise";
+    case ErrorSource::kTable: return "the table's measurement uncertainty";
     case ErrorSource::kInterpolation: return "the interpolation error between the tables' nodes";
     case ErrorSource::kSensor: return "the marker sensor's accuracy through the estimator";
     case ErrorSource::kScanRepeatability: return "the robot's repeatability at the trips";
     case ErrorSource::kLatency: return "the trip latency (scan speed x servo period)";
-    case ErrorSource::kTripTables: return "the noise of the tables under the trips";
+    case ErrorSource::kTripTables: return "the measurement uncertainty of the tables under the trips";
     case ErrorSource::kUncalibratedTrips: return "the robot's own error at trips outside every table";
   }
   return "?";
@@ -112,12 +112,22 @@ ErrorSource ErrorBudget::Largest() const {
   return static_cast<ErrorSource>(largest);
 }
 
+// The measurement's own uncertainty (docs/measure.md, "The measurement's
+// uncertainty"): the scatter of a node's readings (type A, stddev / sqrt(n))
+// and everything else measure read budgets (type B: the artefact's
+// certificate, the stylus and hole diameters, the probe's latency, the
+// registration of the artefact's placements; the table's u_mm column),
+// combined per node as GUM does; the largest over the axis's nodes.
 Eigen::Vector2d TableStandardErrorMm(const ErrorTable& table, double repeatability_mm) {
   Eigen::Vector2d se = Eigen::Vector2d::Zero();
   for (TableAxis axis : kTableAxes) {
     const AxisTable& t = table[axis];
     double worst = 0;
-    for (std::size_t k = 0; k < t.error_mm.size(); ++k) worst = std::max(worst, t.StandardErrorMm(k).value_or(repeatability_mm));
+    for (std::size_t k = 0; k < t.error_mm.size(); ++k) {
+      const double scatter = t.StandardErrorMm(k).value_or(repeatability_mm);
+      const double rest = k < t.u_mm.size() ? t.u_mm[k].value_or(0.0) : 0.0;
+      worst = std::max(worst, std::hypot(scatter, rest));
+    }
     se[static_cast<int>(axis)] = worst;
   }
   return se;

@@ -6,19 +6,11 @@
 #include <map>
 
 #include "base/check.h"
+#include "calibration/statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
 namespace {
-
-constexpr double kMadToSigma = 1.4826;  // MAD of a normal distribution -> its sigma
-
-double Median(std::vector<double> values) {
-  SMTCAL_CHECK(!values.empty(), "median of nothing");
-  std::sort(values.begin(), values.end());
-  const std::size_t mid = values.size() / 2;
-  return values.size() % 2 == 1 ? values[mid] : 0.5 * (values[mid - 1] + values[mid]);
-}
 
 struct SetOfReadings {
   long long set = 0;

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
+#include "calibration/statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
@@ -42,13 +43,6 @@ std::optional<Prediction> Predicted(const AxisTable& t, const std::vector<double
   }
   if (along_x) return along_x;
   return along_y;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto mid = values.begin() + static_cast<long>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
 }
 
 // The table's values with the nodes in `taken` replaced by what their
@@ -100,8 +94,8 @@ void FindInAxis(TableAxis axis, const AxisTable& t, std::vector<TableOutlier>& o
     }
   }
   if (magnitudes.empty()) return;
-  const double scatter = 1.4826 * Median(magnitudes);
-  const double noise_cap = kOutlierNoiseCapFactor * Median(standard_errors);
+  const double scatter = kMadToSigma * Median(magnitudes);
+  const double noise_cap = standard_errors.empty() ? 0.0 : kOutlierNoiseCapFactor * Median(standard_errors);
   auto noise_of = [&](std::size_t node) { return std::min(t.StandardErrorMm(node).value_or(0.0), noise_cap); };
   // How far a node's value as written is from its prediction, when that is
   // beyond every threshold; 0 otherwise.

@@ -1216,6 +1216,15 @@ std::optional<Measure> Loader::ReadMeasure(const toml::table& table) {
   if (keys.Get("ready_input") != nullptr) {
     m.ready_input = WholeIn(keys, "ready_input", limits::kLinuxCncInput, "motion.digital-in-NN");
   }
+  m.placement_mm = NumberIn(keys, "placement_mm", limits::kPlacementMm, Need::kOptional);
+  m.placement_deg = NumberIn(keys, "placement_deg", limits::kPlacementDeg, Need::kOptional).value_or(0.1);
+  if (auto u = Number(keys, "u_deg", Need::kOptional, limits::kAngleDeg)) {
+    m.u_deg = u->value;
+    CheckInLimit(3, m.u_deg, u->range, "'u_deg' of [measure]");
+  }
+  m.artefact_pitch_error_ppm =
+      NumberIn(keys, "artefact_pitch_error_ppm", limits::kArtefactPitchPpm, Need::kOptional).value_or(0);
+  m.artefact_pitch_u_ppm = NumberIn(keys, "artefact_pitch_u_ppm", limits::kArtefactPitchUPpm, Need::kOptional).value_or(0);
   // The device's own table: required for the device named, refused for the others.
   for (std::size_t d = 0; d < kMeasureDeviceNames.size(); ++d) {
     const std::string_view name = kMeasureDeviceNames[d];
@@ -1254,6 +1263,12 @@ std::optional<Measure> Loader::ReadMeasure(const toml::table& table) {
       p.stylus_diameter_mm = NumberIn(sub, "stylus_diameter_mm", limits::kLengthMm).value_or(0);
       p.speed_mm_s = NumberIn(sub, "speed_mm_s", limits::kSpeedMmS).value_or(1);
       p.overtravel_mm = NumberIn(sub, "overtravel_mm", limits::kLengthMm).value_or(0.5);
+      if (sub.Get("holes") != nullptr) {
+        p.holes = WholeIn(sub, "holes", limits::kProbeHoles, "holes per direction").value_or(0);
+      }
+      p.hole_diameter_u_mm = NumberIn(sub, "hole_diameter_u_mm", limits::kDiameterUMm, Need::kOptional).value_or(0);
+      p.stylus_diameter_u_mm =
+          NumberIn(sub, "stylus_diameter_u_mm", limits::kDiameterUMm, Need::kOptional).value_or(0);
     } else {
       MeasureExternal& e = m.external;
       e.trigger_output = WholeIn(sub, "trigger_output", limits::kLinuxCncInput, "motion.digital-out-NN").value_or(0);

@@ -33,12 +33,27 @@ std::optional<LoadedPlan> LoadPlan(std::uint32_t file, const cell::Cell& cell, D
 //   1,1,1,1,150.000000,60.000000,0.512000,0.500000
 //   ...
 //   # end                       (or "# aborted at visit ..." before an abort)
+//
+// Every line is checked against the plan before anything is computed from
+// it: visit, node, set and repetition are whole numbers within the plan's
+// (never wrapped), the node, set and commanded position are those the plan
+// gives the visit, the visit lies within its block's range, and a visit and
+// repetition appear once per block. A last line without its line end (or
+// glued to a resumed run's header) is cut: its reading is never used.
+struct CutLine {
+  int visit = 0;       // the visit it would have been (0: unknown)
+  SourceRange where;   // the line
+};
 struct LogBlock {
   std::string header;  // the first line, without "# "
   std::string digest;
   int first_visit = 0, last_visit = 0;
+  SourceRange header_range;
   bool ended = false;  // "# end": the program ran to its end
   std::string stopped;  // the "# aborted ..." line, when it stopped
+  int last_visit_logged = 0;      // the last reading's visit (0: none)
+  int last_repetition_logged = 0;
+  std::optional<CutLine> cut;     // its last line, cut short
 };
 struct MeasuringLog {
   std::string name;
@@ -47,8 +62,28 @@ struct MeasuringLog {
   std::vector<int> block_of;      // per reading: its block
 };
 // Reports a file that is no such log (MeasureLogNotARun), a block of
-// another plan (MeasureLogOtherPlan), bad lines (CsvBadNumber,
-// CsvFieldCount).
+// another plan (MeasureLogOtherPlan) or with a visit range that is not the
+// plan's (MeasureLogBadHeader), bad lines (CsvBadNumber, CsvFieldCount,
+// MeasureLogBadInteger), a reading the plan does not have
+// (MeasureLogUnknownVisit, MeasureLogNotPlanned, MeasureLogOutsideRun) and
+// one logged twice in a block (MeasureLogDuplicate). Cut lines are left to
+// the caller (LogBlock::cut): a later block may measure the visit again.
 std::optional<MeasuringLog> ReadMeasuringLog(std::uint32_t file, const LoadedPlan& plan, Diagnostics& diags);
+
+// The settings a reading's meaning depends on (the final approach; the
+// probe's hole and stylus diameters; the transducer's slope and zero), as
+// the measuring program wrote them into each block's header, against the
+// cell's: a difference is an error at the header (MeasureLogSettings).
+void CheckLogSettings(const MeasuringLog& log, const cell::Cell& cell, Diagnostics& diags);
+
+// The same settings as "key value; key value" for the raw file's
+// "measured with:" comment, which `table build --cell` checks
+// (CheckRawSettings).
+std::string MeasuredWith(const cell::Cell& cell);
+inline constexpr std::string_view kMeasuredWithMark = "# measured with: ";
+// Reports (TableRawSettings, at the comment) each setting of the raw
+// file's "measured with:" comment that differs from `cell`'s, and a raw
+// file without that comment.
+void CheckRawSettings(std::uint32_t raw_file, const cell::Cell& cell, Diagnostics& diags);
 
 }  // namespace smtcal::measure

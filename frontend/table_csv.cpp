@@ -33,13 +33,15 @@ struct Schema {
 };
 
 const Schema kTableSchema{
-    "an error table", "node and axis", {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n", "kind"}, 4, false};
-const Schema kRawSchema{
-    "a raw measurement file", "measurement", {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm", "kind"}, 6,
-    false};
+    "an error table", "node and axis",
+    {"axis", "x_mm", "y_mm", "error_mm", "stddev_mm", "n", "kind", "u_mm", "reversal_mm"}, 4, false};
+const Schema kRawSchema{"a raw measurement file", "measurement",
+                        {"axis", "x_mm", "y_mm", "set", "repetition", "error_mm", "kind", "u_mm", "approach"}, 6,
+                        false};
 const Schema kPointSchema{"a point list", "point", {"x_mm", "y_mm"}, 2, true};
 const Schema kPlanSchema{"a measurement plan", "visit",
-                         {"visit", "region", "axes", "station", "kind", "node", "x_mm", "y_mm", "set", "repetitions"},
+                         {"visit", "region", "axes", "station", "kind", "node", "x_mm", "y_mm", "set", "repetitions",
+                          "approach"},
                          10, false};
 const Schema kExternalSchema{
     "an external system's readings", "reading", {"node", "set", "repetition", "x_mm", "y_mm"}, 5, false};
@@ -382,7 +384,7 @@ std::vector<CsvRecord> SplitCsv(std::uint32_t file, Diagnostics& diags) {
 }
 
 std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kError, kStddev, kCount, kKind };
+  enum { kAxis, kX, kY, kError, kStddev, kCount, kKind, kU, kReversal };
   auto read_row = [&](Row& row, const CsvRecord&) -> std::optional<TableNode> {
     TableNode node;
     std::optional<TableAxis> axis = row.Axis(kAxis);
@@ -390,9 +392,16 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
     std::optional<double> x = row.Number(kX), y = row.Number(kY), error = row.Number(kError);
     node.stddev_mm = row.Number(kStddev, true);
     std::optional<long long> count = row.Count(kCount, 1, true);
+    node.u_mm = row.Number(kU, true);
+    node.reversal_mm = row.Number(kReversal, true);
     if (!row.ok) return std::nullopt;
     if (node.stddev_mm && *node.stddev_mm < 0) {
       diags.Report(DiagKind::TableNegativeStddev, row.Range(kStddev), row.Field(kStddev)->text);
+      return std::nullopt;
+    }
+    if (node.u_mm && *node.u_mm < 0) {
+      diags.Report(DiagKind::TableNegativeValue, row.Range(kU), "u_mm", Printable(row.Field(kU)->text),
+                   "a standard uncertainty");
       return std::nullopt;
     }
     node.kind = *kind;
@@ -412,15 +421,28 @@ std::optional<ErrorTable> ReadErrorTable(std::uint32_t file, Diagnostics& diags)
 }
 
 std::optional<std::vector<RawMeasurement>> ReadRawMeasurements(std::uint32_t file, Diagnostics& diags) {
-  enum { kAxis, kX, kY, kSet, kRepetition, kError, kKind };
-  auto read_row = [](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
+  enum { kAxis, kX, kY, kSet, kRepetition, kError, kKind, kU, kApproach };
+  auto read_row = [&](Row& row, const CsvRecord&) -> std::optional<RawMeasurement> {
     std::optional<TableAxis> axis = row.Axis(kAxis);
     std::optional<ReadingKind> kind = row.Kind(kKind);
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     std::optional<long long> set = row.Count(kSet, 0), repetition = row.Count(kRepetition, 0);
     std::optional<double> error = row.Number(kError);
+    std::optional<double> u = row.Number(kU, true);
+    // The approach: '+' (the final approach, the default) or '-' (against it).
+    std::optional<std::size_t> approach;
+    if (const CsvField* field = row.Field(kApproach); field != nullptr && !field->text.empty()) {
+      approach = row.Choice(kApproach, {"+", "-"});
+    }
     if (!row.ok) return std::nullopt;
+    if (u && *u < 0) {
+      diags.Report(DiagKind::TableNegativeValue, row.Range(kU), "u_mm", Printable(row.Field(kU)->text),
+                   "a standard uncertainty");
+      return std::nullopt;
+    }
     RawMeasurement m;
+    m.u_mm = u;
+    m.reverse = approach == std::size_t{1};
     m.kind = *kind;
     m.axis = *axis;
     m.x_mm = *x;
@@ -451,7 +473,7 @@ std::optional<std::vector<PointRow>> ReadPoints(std::uint32_t file, Diagnostics&
 }
 
 std::optional<std::vector<PlanRow>> ReadMeasurementPlan(std::uint32_t file, Diagnostics& diags) {
-  enum { kVisit, kRegion, kAxes, kStation, kKind, kNode, kX, kY, kSet, kRepetitions };
+  enum { kVisit, kRegion, kAxes, kStation, kKind, kNode, kX, kY, kSet, kRepetitions, kApproach };
   auto read_row = [](Row& row, const CsvRecord& record) -> std::optional<PlanRow> {
     PlanRow plan;
     std::optional<long long> visit = row.Count(kVisit, 1), station = row.Count(kStation, 1),
@@ -459,7 +481,11 @@ std::optional<std::vector<PlanRow>> ReadMeasurementPlan(std::uint32_t file, Diag
                              repetitions = row.Count(kRepetitions, 1);
     std::optional<std::string> region = row.Text(kRegion);
     std::optional<std::size_t> axes = row.Choice(kAxes, {"x", "y", "xy"});
-    std::optional<std::size_t> kind = row.Choice(kKind, {"node", "check"});
+    std::optional<std::size_t> kind = row.Choice(kKind, {"node", "check", "tie", "closure"});
+    std::optional<std::size_t> approach;
+    if (const CsvField* field = row.Field(kApproach); field != nullptr && !field->text.empty()) {
+      approach = row.Choice(kApproach, {"+", "-"});
+    }
     std::optional<double> x = row.Number(kX), y = row.Number(kY);
     if (!row.ok) return std::nullopt;
     constexpr long long kMaxCount = 1 << 30;
@@ -473,6 +499,7 @@ std::optional<std::vector<PlanRow>> ReadMeasurementPlan(std::uint32_t file, Diag
     plan.at = Eigen::Vector2d(*x, *y);
     plan.set = small(*set);
     plan.repetitions = small(*repetitions);
+    plan.direction = approach == std::size_t{1} ? -1 : 1;
     plan.line = record.line;
     plan.visit_field = row.Range(kVisit);
     plan.region_field = row.Range(kRegion);

@@ -72,6 +72,7 @@ struct PlanRow {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();
   int set = 1;
   int repetitions = 1;
+  int direction = 1;  // the optional approach column: +1 (the final approach), -1 (against it)
   std::uint32_t line = 0;
   SourceRange visit_field, region_field, node_field;
 };

@@ -25,6 +25,7 @@ struct PlanOptionsCli {
   int sets = 2;
   int repetitions = 10;
   bool no_check_points = false;
+  bool bidirectional = false;
 };
 
 void RunPlan(const PlanOptionsCli& opt, GlobalOptions& options) {
@@ -48,6 +49,7 @@ void RunPlan(const PlanOptionsCli& opt, GlobalOptions& options) {
     plan_options.sets = opt.sets;
     plan_options.repetitions = opt.repetitions;
     plan_options.check_points = !opt.no_check_points;
+    plan_options.bidirectional = opt.bidirectional;
     plan = measure::MakePlan(*loaded.value(), plan_options, diags);
   }
   options.exit_code = PrintDiagnostics(diags, options);
@@ -74,8 +76,10 @@ void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options) {
       "grid over its bounds and a margin for the robot's error, the pitch (default: where verify's estimate of\n"
       "the interpolation error is 10 % of the tolerance: from the robot's declared roughness, or from the grid\n"
       "advice of the region's previous table when it exists), check points between nodes, sets x repetitions (the paper's\n"
-      "2 x 10), every node reached by the robot's final approach, in serpentine order; prints the summary and\n"
-      "the time at the cell's speeds. A region whose table file does not exist yet needs its bounds x_mm, y_mm");
+      "2 x 10), every node reached by the robot's final approach, in serpentine order; the stations (placements of\n"
+      "the artefact: several regions on one, neighbours tied by measuring a line of each other's nodes), each set\n"
+      "closed by its first point again; prints the summary and the time at the cell's speeds. A region whose table\n"
+      "file does not exist yet needs its bounds x_mm, y_mm");
   plan->add_option("--cell", opt.cell, "the cell file ([measure] describes the device)")->required();
   plan->add_option("-o,--output", opt.output, "the plan to write (CSV; '-' for stdout)")->required();
   plan->add_option("--region", opt.regions, "measure only this region (repeatable; default: every region)");
@@ -88,6 +92,9 @@ void AddMeasurePlanCommand(CLI::App& measure, GlobalOptions& options) {
       ->capture_default_str();
   plan->add_flag("--no-check-points", opt.no_check_points,
                  "no check points between nodes (the interpolation error is then estimated from the table alone)");
+  plan->add_flag("--bidirectional", opt.bidirectional,
+                 "the bidirectional measurement of ISO 230-2: every point also approached (and probed) against the final\n"
+                 "approach; table build gives each node its reversal value (reversal_mm: the backlash)");
   plan->callback([&options] { RunPlan(opt, options); });
 }
 

@@ -17,6 +17,7 @@
 #include "calibration/tolerances.h"
 #include "frontend/cell_toml.h"
 #include "calibration/limits.h"
+#include "frontend/measurement_input.h"
 #include "frontend/table_csv.h"
 #include "tools/commands.h"
 
@@ -105,12 +106,17 @@ bool FilesClashIn(const TableOptions& opt, bool with_points, GlobalOptions& opti
 void RunBuild(const TableOptions& opt, GlobalOptions& options) {
   if (FilesClashIn(opt, false, options)) return;
   SourceManager sources;
+  Diagnostics diags(sources);
+  // With --cell: the settings the raw file was measured with (its
+  // "measured with:" comment) against the cell's.
+  std::optional<cell::Cell> cell;
+  if (!opt.cell.empty() && !LoadCellForMeasure(opt.cell, sources, diags, options, cell)) return;
   Result<std::uint32_t> file = sources.Load(opt.input);
   if (!file) {
     options.exit_code = ReportIoError(file.error());
     return;
   }
-  Diagnostics diags(sources);
+  if (cell) measure::CheckRawSettings(file.value(), *cell, diags);
   std::optional<std::vector<RawMeasurement>> raw = ReadRawMeasurements(file.value(), diags);
   std::optional<ErrorTable> table;
   BuildOptions build;
@@ -119,7 +125,21 @@ void RunBuild(const TableOptions& opt, GlobalOptions& options) {
   if (table) ValidateErrorTable(*table, diags, TableWarnings::kReport);
   std::string text;
   if (table && !diags.has_errors()) {
-    text = FormatTableCsv(*table, BuiltTableComment(BaseName(opt.input)));
+    std::vector<std::string> comment = BuiltTableComment(BaseName(opt.input));
+    bool u = false, reversal = false;
+    for (const AxisTable& t : table->axes) {
+      for (const auto& v : t.u_mm) u = u || v.has_value();
+      for (const auto& v : t.reversal_mm) reversal = reversal || v.has_value();
+    }
+    if (u) {
+      comment.push_back("u_mm: the largest standard uncertainty of the node's readings from everything but their "
+                        "scatter (measure read's budget: the artefact, the device's geometry, the registration)");
+    }
+    if (reversal) {
+      comment.push_back("reversal_mm: the mean of the readings approached against the final approach less error_mm "
+                        "(ISO 230-2's reversal value: the backlash)");
+    }
+    text = FormatTableCsv(*table, comment);
   }
   Finish(diags, options, opt.output, text);
 }
@@ -278,6 +298,9 @@ void AddTableCommand(CLI::App& app, GlobalOptions& options) {
   build->add_flag("--drop-outlier-readings", opt.drop_outlier_readings,
                   "leave readings (and sets) far from their node's others out of the means,\n"
                   "each reported as a warning, instead of stopping at them");
+  build->add_option("--cell", opt.cell,
+                    "the cell the table is for: the final approach and the device's settings the raw file says it\n"
+                    "was measured with (smtcal measure read writes them) must be the cell's");
   build->callback([&options] { RunBuild(opt, options); });
 
   CLI::App* check = table->add_subcommand(

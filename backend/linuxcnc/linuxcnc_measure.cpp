@@ -1,6 +1,7 @@
 // The measuring programs for LinuxCNC (backend/linuxcnc/linuxcnc_measure.h).
 #include "backend/linuxcnc/linuxcnc_measure.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -26,11 +27,27 @@ std::string Safe(std::string_view name) {
   return out;
 }
 
-std::string ProgramStem(const measure::Plan& plan, const measure::VisitGroup& group, bool several_stations) {
-  std::string stem = "measure_" + Safe(plan.regions[group.region].name);
+// measure_s<station>[_<axis>]: one program per placement of the artefact.
+std::string ProgramStem(const measure::VisitGroup& group) {
+  std::string stem = fmt::format("measure_s{}", group.station);
   if (group.axes != measure::MeasuredAxes::kXY) stem += "_" + std::string(measure::MeasuredAxesName(group.axes));
-  if (several_stations) stem += fmt::format("_s{}", group.station);
   return stem;
+}
+
+// The settings a reading's meaning depends on, as "; key value" items of
+// the log's header: `measure read` refuses a log measured with others than
+// the cell's.
+std::string LoggedSettings(const cell::Cell& cell) {
+  const cell::Measure& m = *cell.measure;
+  const Eigen::Vector2d approach = *cell.robot.final_approach_mm;
+  std::string out = fmt::format("; approach {} {}", Num(approach.x()), Num(approach.y()));
+  if (m.device == cell::MeasureDevice::kProbe) {
+    out += fmt::format("; hole_diameter_mm {}; stylus_diameter_mm {}; overtravel_mm {}", Num(m.probe.hole_diameter_mm),
+                       Num(m.probe.stylus_diameter_mm), Num(m.probe.overtravel_mm));
+  } else if (m.device == cell::MeasureDevice::kTransducer) {
+    out += fmt::format("; slope {}; zero_mm {}", Num(m.transducer.slope), Num(m.transducer.zero_mm));
+  }
+  return out;
 }
 
 // The device's settings as the runtime's globals.
@@ -41,6 +58,9 @@ std::string DeviceGlobals(const cell::Cell& cell) {
   auto set = [&](std::string_view name, double value, std::string_view comment) {
     out += fmt::format("#<_smtcal_m_{}> = {} ({})\n", name, Num(value), comment);
   };
+  set("safe_z", std::max(cell.robot.safe_limz_mm, m.clear_z_mm),
+      "robot.safe_limz_mm: each program first rises to it where the head stands, never lowering it");
+  set("u", m.u_deg, "measure.u_deg: the nozzle angle the device reads at");
   set("clear_z", m.clear_z_mm, "measure.clear_z_mm: the z between nodes");
   set("z", m.z_mm, "measure.z_mm: the z at which the device reads");
   set("ax", approach.x(), "robot.final_approach_mm x: the last move onto every node");
@@ -92,40 +112,50 @@ MeasuringPrograms EmitMeasuringPrograms(const measure::LoadedPlan& loaded, const
   const std::string plan_name = Safe(std::filesystem::path(loaded.name).filename().string());
   MeasuringPrograms out;
   const std::vector<measure::VisitGroup> groups = measure::GroupVisits(plan.visits);
-  std::vector<int> stations(plan.regions.size(), 1);
-  for (const measure::VisitGroup& group : groups) stations[group.region] = std::max(stations[group.region], group.station);
+  const char rotation = cell.linuxcnc ? cell.linuxcnc->rotation_axis : 'C';
   for (const measure::VisitGroup& group : groups) {
     const int last = plan.visits[group.first + group.count - 1].number;
     if (last < start) continue;
     const int first = std::max(start, plan.visits[group.first].number);
     const bool resumed = first != plan.visits[group.first].number;
-    const std::string stem = ProgramStem(plan, group, stations[group.region] > 1);
+    const std::string stem = ProgramStem(group);
     const std::string log = (log_dir.empty() ? "" : log_dir + "/") + stem + ".log";
-    const measure::PlanRegion& region = plan.regions[group.region];
+    std::string regions;
+    for (std::size_t k = group.first; k < group.first + group.count; ++k) {
+      const std::string name = Safe(plan.regions[plan.visits[k].region].name);
+      if ((" " + regions + " ").find(" " + name + " ") == std::string::npos) regions += (regions.empty() ? "" : " ") + name;
+    }
     std::string text;
-    text += fmt::format("(smtcal measuring program: region {} - axes {} - station {} - device {})\n", Safe(region.name),
-                        measure::MeasuredAxesName(group.axes), group.station, device);
+    text += fmt::format("(smtcal measuring program: station {} - regions {} - axes {} - device {})\n", group.station,
+                        regions, measure::MeasuredAxesName(group.axes), device);
     text += fmt::format("(from the plan {} - digest {} - visits {} to {}{} - for cell {})\n", plan_name,
                         loaded.digest, first, last, resumed ? " - resumed" : "", Safe(cell.name));
-    text += "(docs/measure.md: mount the device - home the machine - run; the log goes to " + log + ")\n";
+    text += "(docs/measure.md: put the artefact down as the plan says - mount the device - home the machine - run;"
+            " the log goes to " + log + ")\n";
     text += "G21 G90 G17 G94\n";
     text += globals;
+    text += "#<_smtcal_m_visit> = 0 (the visit being measured, for o<smtcal_measure_on_abort>)\n";
+    text += "#<_smtcal_m_rep> = 0\n";
     text += fmt::format("({},{})\n", resumed ? "LOGAPPEND" : "LOGOPEN", log);
     text += fmt::format(
-        "(LOG,# smtcal measuring log: plan {} digest {}; program {}; region {}; axes {}; station {}; device {}; "
+        "(LOG,# smtcal measuring log: plan {} digest {}; program {}; station {}; regions {}; axes {}; device {}{}; "
         "visits {}..{})\n",
-        plan_name, loaded.digest, stem, Safe(region.name), measure::MeasuredAxesName(group.axes),
-        group.station, device, first, last);
+        plan_name, loaded.digest, stem, group.station, regions, measure::MeasuredAxesName(group.axes), device,
+        LoggedSettings(cell), first, last);
     text += "(LOG,visit,node,set,repetition,x_mm,y_mm,a_mm,b_mm)\n";
+    text += fmt::format("o<smtcal_measure_start> call (rise where the head stands, then turn {} to the device's angle)\n",
+                        rotation);
+    text += fmt::format("G0 {}#<_smtcal_m_u>\n", rotation);
     for (std::size_t k = group.first; k < group.first + group.count; ++k) {
       const measure::Visit& v = plan.visits[k];
       if (v.number < first) continue;
-      text += fmt::format("o<smtcal_measure_{}> call [{}] [{}] [{}] [{}] [{}] [{}] ({} {} set {})\n", device, v.number,
-                          v.node, v.set, v.repetitions, Num(v.at.x()), Num(v.at.y()),
-                          measure::VisitKindName(v.kind), v.node, v.set);
+      text += fmt::format("o<smtcal_measure_{}> call [{}] [{}] [{}] [{}] [{}] [{}] [{}] ({} {} set {}{})\n", device,
+                          v.number, v.node, v.set, v.repetitions, Num(v.at.x()), Num(v.at.y()), v.direction,
+                          measure::VisitKindName(v.kind), v.node, v.set, v.direction < 0 ? " against the approach" : "");
     }
+    text += "#<_smtcal_m_visit> = 0\n";
     text += "(LOG,# end)\n(LOGCLOSE)\n";
-    text += fmt::format("G0 Z{}\nM2\n", Num(cell.measure->clear_z_mm));
+    text += "G0 Z#<_smtcal_m_safe_z>\nM2\n";
     out.programs.push_back({stem + ".ngc", std::move(text)});
     out.logs.push_back(log);
   }

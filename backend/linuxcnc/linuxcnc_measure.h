@@ -15,7 +15,7 @@
 namespace smtcal {
 
 struct MeasuringPrograms {
-  std::vector<EmbeddedFile> programs;     // measure_<region>[_<axis>][_s<station>].ngc, in plan order
+  std::vector<EmbeddedFile> programs;     // measure_s<station>[_<axis>].ngc, in plan order
   std::vector<EmbeddedFile> subroutines;  // the measuring runtime
   std::vector<std::string> logs;          // per program: the log file it writes
 };

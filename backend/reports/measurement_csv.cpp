@@ -45,10 +45,39 @@ std::vector<std::string> PlanSummary(const measure::Plan& plan, std::string_view
     lines.push_back(fmt::format("  {} set{} x {} repetition{}{}; {}", region.sets, region.sets == 1 ? "" : "s",
                                 region.repetitions, region.repetitions == 1 ? "" : "s",
                                 plan.device == cell::MeasureDevice::kTransducer
-                                    ? fmt::format(", x and y measured apart, the plate mounted {} time{} per axis",
+                                    ? fmt::format(", x and y measured apart, on {} placement{} of the plate",
                                                   region.stations, region.stations == 1 ? "" : "s")
                                     : "",
                                 FormatDuration(region.time_s)));
+  }
+  for (const measure::PlanStation& station : plan.stations) {
+    std::string regions;
+    for (std::size_t r : station.regions) regions += (regions.empty() ? "" : ", ") + plan.regions[r].name;
+    if (regions.empty()) regions = "ties only";
+    std::string ties;
+    if (!station.tied_to.empty()) {
+      std::string with;
+      for (int t : station.tied_to) with += (with.empty() ? "" : ", ") + std::to_string(t);
+      ties = fmt::format("; tied to station{} {}{}", station.tied_to.size() == 1 ? "" : "s", with,
+                         station.ties > 0 ? fmt::format(" ({} tie point{} measured here)", station.ties,
+                                                        station.ties == 1 ? "" : "s")
+                                          : "");
+    }
+    const std::string reference = plan.device == cell::MeasureDevice::kProbe        ? "the plate's corner hole"
+                                  : plan.device == cell::MeasureDevice::kTransducer ? "the plate's first groove node"
+                                                                                    : "nothing (no artefact)";
+    lines.push_back(fmt::format("station {}{}: {}; {} at ({}, {}), reaching to ({}, {}){}", station.number,
+                                station.axes == measure::MeasuredAxes::kXY
+                                    ? ""
+                                    : fmt::format(" ({})", measure::MeasuredAxesName(station.axes)),
+                                regions, reference, Mm(station.origin.x()), Mm(station.origin.y()), Mm(station.far.x()),
+                                Mm(station.far.y()), ties));
+  }
+  if (plan.device == cell::MeasureDevice::kProbe && plan.probe_reach_mm > 0) {
+    lines.push_back(fmt::format("probing: a wall may lie up to {} mm from where a probe move expects it (the robot's "
+                                "error, the plate's placement and turn); every probe move starts farther than that "
+                                "from it and runs at the probing feed",
+                                Mm(plan.probe_reach_mm)));
   }
   for (const std::string& note : plan.notes) lines.push_back("note: " + note);
   lines.push_back(fmt::format("{} visits, {} readings: {} at the cell's speeds (moves, dwell and the device's "
@@ -61,11 +90,15 @@ std::string FormatPlanCsv(const measure::Plan& plan, std::string_view cell_path)
   std::string out;
   for (const std::string& line : PlanSummary(plan, cell_path)) out += fmt::format("# {}\n", line);
   out += "# Make the measuring programs: smtcal measure program THIS_FILE --cell CELL -o DIR\n";
-  out += "visit,region,axes,station,kind,node,x_mm,y_mm,set,repetitions\n";
+  const bool both = std::any_of(plan.visits.begin(), plan.visits.end(),
+                                [](const measure::Visit& v) { return v.direction < 0; });
+  out += both ? "visit,region,axes,station,kind,node,x_mm,y_mm,set,repetitions,approach\n"
+              : "visit,region,axes,station,kind,node,x_mm,y_mm,set,repetitions\n";
   for (const measure::Visit& v : plan.visits) {
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{}\n", v.number, plan.regions[v.region].name,
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{}{}\n", v.number, plan.regions[v.region].name,
                        measure::MeasuredAxesName(v.axes), v.station, measure::VisitKindName(v.kind), v.node,
-                       Mm(v.at.x()), Mm(v.at.y()), v.set, v.repetitions);
+                       Mm(v.at.x()), Mm(v.at.y()), v.set, v.repetitions,
+                       both ? (v.direction < 0 ? ",-" : ",+") : "");
   }
   return out;
 }
@@ -75,12 +108,22 @@ std::string FormatRawCsv(const std::vector<RawMeasurement>& rows, const std::vec
   std::string out;
   for (const std::string& line : comment) out += fmt::format("# {}\n", line);
   const bool kinds = std::find(checks.begin(), checks.end(), true) != checks.end();
-  out += kinds ? "axis,x_mm,y_mm,set,repetition,error_mm,kind\n" : "axis,x_mm,y_mm,set,repetition,error_mm\n";
+  const bool uncertain = std::any_of(rows.begin(), rows.end(), [](const RawMeasurement& m) { return m.u_mm.has_value(); });
+  const bool both = std::any_of(rows.begin(), rows.end(), [](const RawMeasurement& m) { return m.reverse; });
+  out += "axis,x_mm,y_mm,set,repetition,error_mm";
+  out += uncertain ? ",u_mm" : "";
+  out += both ? ",approach" : "";
+  out += kinds ? ",kind\n" : "\n";
+  auto six = [](double v) {
+    v = std::round(v * 1e6) / 1e6;
+    return v == 0 ? 0.0 : v;  // never "-0.000000"
+  };
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const RawMeasurement& m = rows[k];
-    double error = std::round(m.error_mm * 1e6) / 1e6;
-    if (error == 0) error = 0;  // never "-0.000000"
-    out += fmt::format("{},{},{},{},{},{:.6f}", AxisName(m.axis), Mm(m.x_mm), Mm(m.y_mm), m.set, m.repetition, error);
+    out += fmt::format("{},{},{},{},{},{:.6f}", AxisName(m.axis), Mm(m.x_mm), Mm(m.y_mm), m.set, m.repetition,
+                       six(m.error_mm));
+    if (uncertain) out += m.u_mm ? fmt::format(",{:.6f}", six(*m.u_mm)) : ",";
+    if (both) out += m.reverse ? ",-" : ",+";
     out += kinds ? (checks[k] ? ",check\n" : ",node\n") : "\n";
   }
   return out;

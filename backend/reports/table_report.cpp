@@ -39,25 +39,35 @@ std::string Range(const std::vector<double>& lines) {
 std::string FormatTableCsv(const ErrorTable& table, const std::vector<std::string>& comment) {
   std::string out;
   for (const std::string& line : comment) out += "# " + line + "\n";
-  bool stddev = false, count = false, checks = false;
+  bool stddev = false, count = false, checks = false, uncertainty = false, reversal = false;
   for (const AxisTable& t : table.axes) {
     for (const auto& sd : t.stddev_mm) stddev = stddev || sd.has_value();
     for (int n : t.count) count = count || n > 0;
+    for (const auto& u : t.u_mm) uncertainty = uncertainty || u.has_value();
+    for (const auto& r : t.reversal_mm) reversal = reversal || r.has_value();
     for (const TableNode& check : t.checks) {
       stddev = stddev || check.stddev_mm.has_value();
       count = count || check.count > 0;
+      uncertainty = uncertainty || check.u_mm.has_value();
+      reversal = reversal || check.reversal_mm.has_value();
     }
     checks = checks || !t.checks.empty();
   }
   out += "axis,x_mm,y_mm,error_mm";
   if (stddev) out += ",stddev_mm";
   if (count) out += ",n";
+  if (uncertainty) out += ",u_mm";
+  if (reversal) out += ",reversal_mm";
   if (checks) out += ",kind";
   out += "\n";
-  auto row = [&](TableAxis axis, ReadingKind kind, double x, double y, double error, std::optional<double> sd, int n) {
+  auto optional = [](const std::optional<double>& v) { return v ? Fixed(*v, 6) : std::string(); };
+  auto row = [&](TableAxis axis, ReadingKind kind, double x, double y, double error, std::optional<double> sd, int n,
+                 std::optional<double> u, std::optional<double> r) {
     out += fmt::format("{},{},{},{}", AxisName(axis), FormatMm(x), FormatMm(y), Fixed(error, 6));
-    if (stddev) out += "," + (sd ? Fixed(*sd, 6) : std::string());
+    if (stddev) out += "," + optional(sd);
     if (count) out += "," + (n > 0 ? fmt::format("{}", n) : std::string());
+    if (uncertainty) out += "," + optional(u);
+    if (reversal) out += "," + optional(r);
     if (checks) out += fmt::format(",{}", ReadingKindName(kind));
     out += "\n";
   };
@@ -67,7 +77,8 @@ std::string FormatTableCsv(const ErrorTable& table, const std::vector<std::strin
       for (std::size_t i = 0; i < t.nx(); ++i) {
         std::size_t k = t.Index(i, j);
         row(axis, ReadingKind::kNode, t.xs[i], t.ys[j], t.error_mm[k],
-            t.stddev_mm.empty() ? std::nullopt : t.stddev_mm[k], t.count.empty() ? 0 : t.count[k]);
+            t.stddev_mm.empty() ? std::nullopt : t.stddev_mm[k], t.count.empty() ? 0 : t.count[k],
+            t.u_mm.empty() ? std::nullopt : t.u_mm[k], t.reversal_mm.empty() ? std::nullopt : t.reversal_mm[k]);
       }
     }
   }
@@ -75,7 +86,8 @@ std::string FormatTableCsv(const ErrorTable& table, const std::vector<std::strin
   // they were when check points are added.
   for (TableAxis axis : kTableAxes) {
     for (const TableNode& check : table[axis].checks) {
-      row(axis, ReadingKind::kCheck, check.x_mm, check.y_mm, check.error_mm, check.stddev_mm, check.count);
+      row(axis, ReadingKind::kCheck, check.x_mm, check.y_mm, check.error_mm, check.stddev_mm, check.count, check.u_mm,
+          check.reversal_mm);
     }
   }
   return out;

@@ -7,7 +7,9 @@
 #
 # Reads the plan (JSON, path in $SMTCAL_SIM_PLAN):
 #   programs  [{"path": ..., "setup": [halcmd lines run before it],
-#               "fault_after_s": s (optional: the device's ready signal drops then)}, ...]
+#               "fault_after_s": s (optional: the device's ready signal drops then),
+#               "events": [{"after_s": s, "hal": [halcmd lines]}, ...] (optional: e.g.
+#               the plate bumped while the program runs)}, ...]
 #   ready_signal the HAL signal of the device's ready input
 #   external  {"trigger": n, "done_signal": "ext-done", "node_out": k,
 #              "noise_mm": s, "seed": n, "readings": path} or null
@@ -102,10 +104,15 @@ def main():
         trigger_was = False
         aborted = False
         fault_at = time.monotonic() + program["fault_after_s"] if "fault_after_s" in program else None
+        events = sorted(((time.monotonic() + e["after_s"], e["hal"]) for e in program.get("events", [])),
+                        key=lambda e: e[0])
         while True:
             if fault_at is not None and time.monotonic() > fault_at:
                 hal([f"sets {plan['ready_signal']} false"])  # the device faults
                 fault_at = None
+            while events and time.monotonic() > events[0][0]:
+                hal(events.pop(0)[1])
+                record.setdefault("events", []).append({"t": now(), "program": os.path.basename(program["path"])})
             if time.monotonic() > deadline:
                 command.abort()
                 save("timeout: the run took longer than %s s" % plan["timeout_s"])

@@ -17,9 +17,11 @@ Devices (param device: 0 none, 1 transducer, 2 probe):
   from the nearest groove node along ldt-axis; the reference reads the
   compression; both 0 (at rest) without contact. Gaussian noise ldt-noise.
 - probe: a touch probe in a hole plate (holes on a lattice of hole-pitch
-  from hole-x0, hole-y0): contact while the stylus is below plate-z and
-  its real centre is at least the contact radius (plus Gaussian noise
-  probe-noise, drawn anew after every contact) from the nearest hole's centre.
+  from hole-x0, hole-y0, turned by hole-angle radians about that hole):
+  contact while the stylus is below plate-z and its real centre is at
+  least the contact radius (plus Gaussian noise probe-noise, drawn anew
+  after every contact) from the nearest hole's centre. Setting the
+  parameters while the program runs moves the plate (a bump).
 """;
 
 pin in float x_cmd;
@@ -65,6 +67,7 @@ pin out float ldt_reference;
 
 param rw float hole_x0;
 param rw float hole_y0;
+param rw float hole_angle;
 param rw float hole_pitch = 5;
 param rw float hole_radius = 2;
 param rw float plate_z;
@@ -160,9 +163,13 @@ FUNCTION(_) {
     }
 
     if (device == 2) {
-        double hx = nearest(x_real, hole_x0, hole_pitch);
-        double hy = nearest(y_real, hole_y0, hole_pitch);
-        double r = sqrt((x_real - hx) * (x_real - hx) + (y_real - hy) * (y_real - hy));
+        /* The stylus in the plate's frame (turned by hole_angle about its first hole). */
+        double dx = x_real - hole_x0, dy = y_real - hole_y0;
+        double c = cos(hole_angle), s = sin(hole_angle);
+        double px = c * dx + s * dy, py = -s * dx + c * dy;
+        double hx = nearest(px, 0, hole_pitch);
+        double hy = nearest(py, 0, hole_pitch);
+        double r = sqrt((px - hx) * (px - hx) + (py - hy) * (py - hy));
         int contact = z_real < plate_z && r >= threshold;
         if (probe_contact && !contact) threshold = hole_radius + probe_noise * normal(&rng);
         probe_contact = contact;

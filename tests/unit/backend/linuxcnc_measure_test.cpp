@@ -90,28 +90,34 @@ TEST(LinuxCncMeasure, ProbeProgramApproachesEveryNodeAndAbortsWithoutContact) {
   test::SmtcalRun made = Smtcal(fmt::format("measure program {} --cell {} -o {}", Quote(dir / "plan.csv"),
                                             Quote(kScratchCell), Quote(dir / "out")));
   ASSERT_EQ(made.exit_code, 0) << made.err;
-  ASSERT_TRUE(fs::exists(dir / "out" / "measure_layer1.ngc"));
-  test::Rs274Result run = RunProgram(dir / "out", "measure_layer1.ngc");
+  ASSERT_TRUE(fs::exists(dir / "out" / "measure_s1.ngc"));
+  test::Rs274Result run = RunProgram(dir / "out", "measure_s1.ngc");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("smtcal: measuring stopped at visit 1 - node 1 set 1 repetition 1: the probe did not "
                          "touch the wall along x"),
             std::string::npos)
       << run.err;
   EXPECT_NE(run.err.find("smtcal measure program --start 1"), std::string::npos) << run.err;
-  // The grid's first node is (150, 60) (bounds 150.5..199.5, 25 mm): up to
-  // the clear z, to the approach point, onto the node, down, towards the
-  // wall, the probe move.
-  ASSERT_GE(run.moves.size(), 6u);
+  // The grid's first node is (150, 60) (bounds 150.5..199.5, 25 mm). The
+  // head starts at z 0, the safe height: it is never lowered where it
+  // stands; u (the C axis) is turned to the device's angle; across to the
+  // approach point at that height, down to the clear z, onto the node, down,
+  // towards the wall at rapid to the overtravel short of it (0.8 mm: more
+  // than the robot's error, the plate's placement and turn), the probe move.
+  ASSERT_GE(run.moves.size(), 7u);
   const auto& m = run.moves;
-  EXPECT_NEAR(m[0].xyzabc[2], -5, kPrintedMm);
+  EXPECT_NEAR(m[0].xyzabc[2], 0, kPrintedMm);
+  EXPECT_NEAR(m[0].xyzabc[5], 0, kPrintedMm);
   EXPECT_NEAR(m[1].xyzabc[0], 149.5, kPrintedMm);
   EXPECT_NEAR(m[1].xyzabc[1], 59.5, kPrintedMm);
-  EXPECT_NEAR(m[2].xyzabc[0], 150, kPrintedMm);
-  EXPECT_NEAR(m[2].xyzabc[1], 60, kPrintedMm);
-  EXPECT_NEAR(m[3].xyzabc[2], -8, kPrintedMm);
-  EXPECT_NEAR(m[4].xyzabc[0], 150 + 1.5 - 0.2, kPrintedMm);  // the contact radius less the overtravel
-  EXPECT_EQ(m[5].kind, "STRAIGHT_PROBE");
-  EXPECT_NEAR(m[5].xyzabc[0], 150 + 1.5 + 0.2, kPrintedMm);
+  EXPECT_NEAR(m[1].xyzabc[2], 0, kPrintedMm);
+  EXPECT_NEAR(m[2].xyzabc[2], -5, kPrintedMm);
+  EXPECT_NEAR(m[3].xyzabc[0], 150, kPrintedMm);
+  EXPECT_NEAR(m[3].xyzabc[1], 60, kPrintedMm);
+  EXPECT_NEAR(m[4].xyzabc[2], -8, kPrintedMm);
+  EXPECT_NEAR(m[5].xyzabc[0], 150 + 1.5 - 0.8, kPrintedMm);  // the contact radius less the overtravel
+  EXPECT_EQ(m[6].kind, "STRAIGHT_PROBE");
+  EXPECT_NEAR(m[6].xyzabc[0], 150 + 1.5 + 0.8, kPrintedMm);
   std::vector<std::string> log = LogLines(run);
   ASSERT_GE(log.size(), 3u);
   EXPECT_EQ(log[0].rfind("# smtcal measuring log: plan plan.csv digest ", 0), 0u) << log[0];
@@ -132,14 +138,14 @@ TEST(LinuxCncMeasure, ExternalProgramLogsEveryReadingAndReadsBackToTheErrors) {
   test::SmtcalRun made = Smtcal(fmt::format("measure program {} --cell {} -o {}", Quote(dir / "plan.csv"),
                                             Quote(cell), Quote(dir / "out")));
   ASSERT_EQ(made.exit_code, 0) << made.err;
-  test::Rs274Result run = RunProgram(dir / "out", "measure_layer1.ngc");
+  test::Rs274Result run = RunProgram(dir / "out", "measure_s1.ngc");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::vector<std::string> log = LogLines(run);
   // 3 x 3 nodes and the one check point, 2 sets, 2 repetitions; the header,
   // the column line and "# end".
   ASSERT_EQ(log.size(), 10u * 2 * 2 + 3);
   EXPECT_EQ(log.back(), "# end");
-  std::ofstream(dir / "measure_layer1.log") << [&] {
+  std::ofstream(dir / "measure_s1.log") << [&] {
     std::string text;
     for (const std::string& line : log) text += line + "\n";
     return text;
@@ -156,28 +162,29 @@ TEST(LinuxCncMeasure, ExternalProgramLogsEveryReadingAndReadsBackToTheErrors) {
   }
   std::ofstream(dir / "readings.csv") << readings;
   test::SmtcalRun read = Smtcal(fmt::format("measure read {} {} --cell {} --external {} -o {}",
-                                            Quote(dir / "plan.csv"), Quote(dir / "measure_layer1.log"), Quote(cell),
+                                            Quote(dir / "plan.csv"), Quote(dir / "measure_s1.log"), Quote(cell),
                                             Quote(dir / "readings.csv"), Quote(dir / "raw.csv")));
   ASSERT_EQ(read.exit_code, 0) << read.err;
   const std::string raw = ReadText(dir / "raw.csv");
   EXPECT_NE(raw.find("# plan plan.csv (digest "), std::string::npos) << raw;
-  EXPECT_NE(raw.find("axis,x_mm,y_mm,set,repetition,error_mm,kind\n"), std::string::npos) << raw;
-  EXPECT_NE(raw.find("x,150,60,1,1,-0.002900,node\n"), std::string::npos) << raw;  // node 1: 0.001 - 0.004 + 0.0001
+  EXPECT_NE(raw.find("axis,x_mm,y_mm,set,repetition,error_mm,u_mm,kind\n"), std::string::npos) << raw;
+  // node 1: 0.001 - 0.004 + 0.0001; an external system has no artefact to register
+  EXPECT_NE(raw.find("x,150,60,1,1,-0.002900,0.000000,node\n"), std::string::npos) << raw;
   EXPECT_NE(raw.find(",check\n"), std::string::npos) << raw;
 
   // A reading the system lacks is named; so is a resumed run's start.
   std::string short_readings = readings.substr(0, readings.rfind('\n', readings.size() - 2) + 1);
   std::ofstream(dir / "short.csv") << short_readings;
   test::SmtcalRun missing = Smtcal(fmt::format("measure read {} {} --cell {} --external {} -o {}",
-                                               Quote(dir / "plan.csv"), Quote(dir / "measure_layer1.log"),
+                                               Quote(dir / "plan.csv"), Quote(dir / "measure_s1.log"),
                                                Quote(cell), Quote(dir / "short.csv"), Quote(dir / "raw2.csv")));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("the external readings have none for node"), std::string::npos) << missing.err;
   test::SmtcalRun resumed = Smtcal(fmt::format("measure program {} --cell {} -o {} --start 7",
                                                Quote(dir / "plan.csv"), Quote(cell), Quote(dir / "resumed")));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
-  const std::string text = ReadText(dir / "resumed" / "measure_layer1.ngc");
-  EXPECT_NE(text.find("(LOGAPPEND,measure_layer1.log)"), std::string::npos);
+  const std::string text = ReadText(dir / "resumed" / "measure_s1.ngc");
+  EXPECT_NE(text.find("(LOGAPPEND,measure_s1.log)"), std::string::npos);
   EXPECT_NE(text.find("visits 7..20"), std::string::npos) << text;
   EXPECT_EQ(text.find("o<smtcal_measure_external> call [6]"), std::string::npos);
   fs::remove_all(dir);

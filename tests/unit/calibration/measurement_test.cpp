@@ -56,7 +56,8 @@ cell::Cell TestCell(cell::MeasureDevice device, cell::Interval x, cell::Interval
   m.probe.stylus_diameter_mm = 1;
   m.probe.hole_pitch_mm = 5;
   m.probe.speed_mm_s = 2;
-  m.probe.overtravel_mm = 0.2;
+  m.probe.overtravel_mm = 0.8;  // more than the robot's error, the plate's placement and turn (0.75 mm at most here)
+  m.placement_deg = 0.05;
   m.transducer.groove_pitch_mm = 5;
   m.transducer.grooves = 11;
   c.measure = m;
@@ -79,8 +80,11 @@ TEST(MeasurementPlan, ThePapersCellGetsItsGridAndDefaults) {
   EXPECT_DOUBLE_EQ(r.xs.front(), 150);
   EXPECT_DOUBLE_EQ(r.ys.back(), 110);
   EXPECT_EQ(r.nodes, 121);
-  // Two sets of ten: every node visited once per set, ten readings a visit.
-  EXPECT_EQ(plan->visits.size(), 242u);
+  // Two sets of ten: every node visited once per set, ten readings a
+  // visit, and each set closed by its first node again.
+  EXPECT_EQ(plan->visits.size(), 244u);
+  EXPECT_EQ(plan->visits[121].kind, VisitKind::kClosure);
+  EXPECT_EQ(plan->visits[121].node, plan->visits[0].node);
   for (const Visit& v : plan->visits) EXPECT_EQ(v.repetitions, 10);
   EXPECT_GT(plan->time_s, 0);
 }
@@ -163,10 +167,10 @@ TEST(MeasurementPlan, GridsCoverTheirRegionsOnTheLattice) {
     for (const Visit& v : plan->visits) {
       auto [it, fresh] = node_at.try_emplace(v.node, v.at);
       EXPECT_EQ(it->second, v.at) << "node " << v.node;
-      ++visits_of[{v.node, static_cast<int>(v.axes), v.set}];
+      if (v.kind == VisitKind::kNode || v.kind == VisitKind::kCheck) ++visits_of[{v.node, static_cast<int>(v.axes), v.set}];
       const bool on_x = std::find(r.xs.begin(), r.xs.end(), v.at.x()) != r.xs.end();
       const bool on_y = std::find(r.ys.begin(), r.ys.end(), v.at.y()) != r.ys.end();
-      if (v.kind == VisitKind::kNode) {
+      if (v.kind != VisitKind::kCheck) {
         EXPECT_TRUE(on_x && on_y);
       } else if (device == cell::MeasureDevice::kProbe) {
         EXPECT_FALSE(on_x || on_y);  // a cell's centre
@@ -193,6 +197,84 @@ TEST(MeasurementPlan, GridsCoverTheirRegionsOnTheLattice) {
       for (const auto& [key, box] : span) EXPECT_LE((box.second - box.first).maxCoeff(), 50 + 1e-9);
     }
   }
+}
+
+// The paper cell's regions with a plate of 18 x 18 holes: the markers'
+// regions share a station with the layers they serve, a region wider than
+// the plate is split over stations sharing a line, and ties join every
+// station into one group; every set of a station ends at its first point.
+TEST(MeasurementPlan, StationsOfThePaperCellAreTied) {
+  cell::Cell c = TestCell(cell::MeasureDevice::kProbe, {150.5, 199.5}, {60.5, 109.5});
+  auto region = [&](std::string name, cell::Interval x, cell::Interval y) {
+    cell::Region r = c.regions[0];
+    r.name = std::move(name);
+    r.x_mm = x;
+    r.y_mm = y;
+    c.regions.push_back(r);
+  };
+  c.regions[0].name = "layer1";
+  region("layer2", {205.5, 254.5}, {60.5, 109.5});
+  region("layer3", {260.5, 309.5}, {60.5, 109.5});
+  region("feeders", {155.5, 244.5}, {5.5, 29.5});
+  region("marker1", {128, 152}, {31.5, 55.5});
+  region("marker2", {314, 338}, {114.5, 138.5});
+  c.measure->probe.holes = 18;
+  c.measure->placement_deg = 0.1;
+  PlanOptions options;
+  options.pitch_mm = 5;
+  options.sets = 1;
+  options.repetitions = 1;
+  SourceManager sources;
+  Diagnostics diags(sources);
+  std::optional<Plan> plan = MakePlan(c, options, diags);
+  ASSERT_TRUE(plan) << diags.RenderText();
+  // One group: a walk over the ties reaches every station.
+  std::set<int> reached = {1}, frontier = {1};
+  while (!frontier.empty()) {
+    const int s = *frontier.begin();
+    frontier.erase(frontier.begin());
+    for (int t : plan->stations[static_cast<std::size_t>(s - 1)].tied_to) {
+      if (reached.insert(t).second) frontier.insert(t);
+    }
+  }
+  EXPECT_EQ(reached.size(), plan->stations.size());
+  for (const PlanStation& station : plan->stations) {
+    // The plate (85 mm) reaches every point of its station.
+    EXPECT_LE((station.far - station.origin).maxCoeff(), 85 + 1e-9) << "station " << station.number;
+  }
+  // marker1 shares its station with layer1.
+  bool shared = false;
+  for (const PlanStation& station : plan->stations) {
+    shared = shared || (station.regions.size() >= 2 &&
+                        std::count(station.regions.begin(), station.regions.end(), std::size_t{0}) == 1 &&
+                        std::count(station.regions.begin(), station.regions.end(), std::size_t{4}) == 1);
+  }
+  EXPECT_TRUE(shared);
+  // One measuring program per station (the probe measures x and y
+  // together): a station's regions never split it.
+  const std::vector<VisitGroup> groups = GroupVisits(plan->visits);
+  ASSERT_EQ(groups.size(), plan->stations.size());
+  for (std::size_t g = 0; g < groups.size(); ++g) EXPECT_EQ(groups[g].station, static_cast<int>(g) + 1);
+  // Every set of every station: its last visit is its first point again.
+  std::map<int, std::vector<const Visit*>> of_station;
+  for (const Visit& v : plan->visits) of_station[v.station].push_back(&v);
+  for (const auto& [station, visits] : of_station) {
+    EXPECT_EQ(visits.back()->kind, VisitKind::kClosure);
+    EXPECT_EQ(visits.back()->node, visits.front()->node);
+  }
+  // The probe's clearances: a wall may be the robot's error, the plate's
+  // placement and its turn over the station's diagonal off.
+  EXPECT_GT(plan->probe_reach_mm, 0.5);
+  EXPECT_LT(plan->probe_reach_mm, c.measure->probe.overtravel_mm - kProbeSafetyMarginMm);
+}
+
+TEST(MeasurementPlan, RefusesAnOvertravelShorterThanWhatTheCellDeclares) {
+  cell::Cell c = TestCell(cell::MeasureDevice::kProbe, {150.5, 199.5}, {60.5, 109.5});
+  c.measure->probe.overtravel_mm = 0.2;
+  SourceManager sources;
+  Diagnostics diags(sources);
+  EXPECT_FALSE(MakePlan(c, PlanOptions{}, diags));
+  EXPECT_NE(diags.RenderText().find("overtravel_mm = 0.2 mm is less than"), std::string::npos) << diags.RenderText();
 }
 
 TEST(MeasurementPlan, RefusesACellWithoutDeviceOrApproach) {
@@ -260,7 +342,10 @@ TEST(MeasurementReading, ProbeErrorsAreTheFieldAtTheNodes) {
       }
     }
     std::vector<std::string> notes;
-    std::vector<ReadingError> errors = ErrorsOfReadings(*c.measure, c.robot, xs, ys, readings, notes);
+    PlanRegion grid;
+    grid.xs = xs;
+    grid.ys = ys;
+    std::vector<ReadingError> errors = ErrorsOfReadings(*c.measure, c.robot, {grid}, readings, {}, notes);
     ASSERT_EQ(errors.size(), 2 * readings.size());
     // The field's largest second derivative (its sinusoid's).
     const double curvature = amp * std::pow(2 * M_PI / wave, 2);
@@ -292,13 +377,16 @@ TEST(MeasurementReading, TransducerAndExternal) {
   r.a = 1.0;
   r.b = 0.95;
   std::vector<std::string> notes;
-  std::vector<ReadingError> e = ErrorsOfReadings(*c.measure, c.robot, {150, 160}, {60, 70}, {r}, notes);
+  PlanRegion grid;
+  grid.xs = {150, 160};
+  grid.ys = {60, 70};
+  std::vector<ReadingError> e = ErrorsOfReadings(*c.measure, c.robot, {grid}, {r}, {}, notes);
   ASSERT_EQ(e.size(), 1u);
   EXPECT_EQ(e[0].axis, TableAxis::Y);
   EXPECT_DOUBLE_EQ(e[0].error_mm, ((1.0 - 0.95) - 0.1) / -2);
   c.measure->device = cell::MeasureDevice::kExternal;
   r.external = Eigen::Vector2d(150.012, 59.99);
-  e = ErrorsOfReadings(*c.measure, c.robot, {150, 160}, {60, 70}, {r}, notes);
+  e = ErrorsOfReadings(*c.measure, c.robot, {grid}, {r}, {}, notes);
   ASSERT_EQ(e.size(), 2u);
   EXPECT_NEAR(e[0].error_mm, 0.012, 1e-12);
   EXPECT_NEAR(e[1].error_mm, -0.01, 1e-12);
