@@ -16,7 +16,7 @@
 
 #include "base/check.h"
 #include "calibration/reading_screen.h"
-#include "calibration/statistics.h"
+#include "calibration/sample_statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {

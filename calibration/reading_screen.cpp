@@ -6,7 +6,7 @@
 #include <map>
 
 #include "base/check.h"
-#include "calibration/statistics.h"
+#include "calibration/sample_statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {

@@ -46,7 +46,13 @@ struct MeanSigma {
 MeanSigma MeanAndSigma(const std::vector<double>& values);
 
 // The median: the middle value, the mean of the two middle ones for an even
-// count. At least one value (checked).
+// count. At least one value (checked). The one median of smtcal: the
+// measurement's screens (error_table_build, reading_screen, table_outliers)
+// and the monitor's robust baseline agree on what a centre is.
 double Median(std::vector<double> values);
+
+// The median absolute deviation of a normal distribution times this is its
+// standard deviation (the screens' robust scatter).
+inline constexpr double kMadToSigma = 1.4826;
 
 }  // namespace smtcal

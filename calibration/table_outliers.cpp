@@ -9,7 +9,7 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
-#include "calibration/statistics.h"
+#include "calibration/sample_statistics.h"
 #include "calibration/tolerances.h"
 
 namespace smtcal {
