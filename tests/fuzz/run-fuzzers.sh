@@ -46,6 +46,7 @@ dict_of() {
     previous_json) echo json ;;
     linuxcnc_ini) echo ini ;;
     record_log) echo record ;;
+    measure_log) echo measure ;;
   esac
 }
 

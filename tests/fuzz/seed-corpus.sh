@@ -62,6 +62,9 @@ done
 # Cycle-record logs: the monitor goldens (the long simulated ones go by the
 # 64 KiB rule below).
 seed record_log "$golden"/monitor/*.log
+# Measuring logs: the measure-read goldens and the guide's station logs
+# (examples/calibrating/logs, read against the guide's plan).
+seed measure_log "$golden"/measure-read/*.log examples/calibrating/logs/*.log
 # The loop that runs the compile-time trace to its 5 000 000-statement limit
 # takes 0.3 s in a release build but 10-90 s under the sanitizers on a busy
 # machine: every mutation of it would be a timeout. The golden suite keeps it.
