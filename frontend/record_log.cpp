@@ -78,7 +78,7 @@ ValueRange CheckRange(ScanCheck check, std::size_t trips) {
   switch (check) {
     case ScanCheck::kMissingTrip: return {0, static_cast<double>(trips), "trips"};
     case ScanCheck::kDegenerate: return {0, 1, ""};
-    case ScanCheck::kSquareness:
+    case ScanCheck::kSquareness: return {0, kRecordMaxSquarenessDeg, "deg"};
     case ScanCheck::kNominalRotation:
     case ScanCheck::kCycleRotation: return {0, kRecordMaxAngleDeg, "deg"};
     case ScanCheck::kTripWindow:

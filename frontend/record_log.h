@@ -40,7 +40,11 @@ namespace smtcal {
 
 // The documented ranges of a record's values (docs/monitor.md, "Values").
 inline constexpr double kRecordMaxLengthMm = 1e4;    // positions and lengths: no placement robot reaches 10 m
-inline constexpr double kRecordMaxAngleDeg = 180;    // the angle checks' values
+inline constexpr double kRecordMaxAngleDeg = 180;    // the rotation checks' values (wrapped)
+// The squareness check's: |angle(S2 - S1, S3 - S1) - 90 deg| with the angle
+// from atan2 in (-180, 180], so up to 270 for a scan that finds S3 on the
+// wrong side.
+inline constexpr double kRecordMaxSquarenessDeg = 270;
 inline constexpr double kRecordMaxTimeS = 1e10;      // the controller's clock (about 317 years)
 
 struct LoggedBegin {

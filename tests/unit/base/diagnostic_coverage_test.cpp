@@ -89,6 +89,11 @@ bool HoldsKind(const std::string& err, std::string_view name, const std::regex& 
 }
 
 TEST(DiagnosticCoverage, EveryKindHasAGoldenCaseThatEmitsIt) {
+#if defined(SMTCAL_SANITIZED)
+  // A check of the repository's files, run by the ordinary build; under the
+  // sanitizers its regular expressions took 95 s and checked nothing more.
+  GTEST_SKIP() << "run by the ordinary build";
+#endif
   const std::map<std::string, std::vector<fs::path>> cases = GoldenCases();
   std::vector<std::string> kinds = {
 #define DIAG(name, severity, format) #name,

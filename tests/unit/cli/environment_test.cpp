@@ -217,7 +217,7 @@ TEST_F(Environment, ReportAndProgramAreWrittenTogetherOrNotAtAll) {
 // Out of memory is reported as such (exit 3), never as a mistake in the
 // input. (ASan reserves more address space than the limit allows.)
 TEST_F(Environment, OutOfMemoryIsExitThreeNotAnInputError) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(SMTCAL_SANITIZED)
   GTEST_SKIP() << "ulimit -v and AddressSanitizer do not mix";
 #endif
   {

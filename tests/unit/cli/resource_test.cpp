@@ -22,7 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_UNDEFINED__)
+#if defined(SMTCAL_SANITIZED)  // the top-level CMakeLists.txt, SMTCAL_SANITIZE
 constexpr bool kSanitized = true;
 #else
 constexpr bool kSanitized = false;

@@ -145,8 +145,11 @@ TEST(RecordLog, RecordsThatSayImpossibleThingsAreErrorsNamingTheRecord) {
       {std::string(kBegin) + Record(1, "0 0 - 138 40 328 40 138 130", "0 0.1 0 0 0 0 1e300 0 0 - -"),
        "the value of check 7 (line_residual) of the record of cycle 1 of fixture 'Board' is 1e300: outside "
        "0..100000 mm"},
-      {std::string(kBegin) + Record(1, "0 0 - 138 40 328 40 138 130", "0 0.1 0 0 0 200 0.01 0 0 - -"),
-       "the value of check 6 (squareness) of the record of cycle 1 of fixture 'Board' is 200: outside 0..180 deg"},
+      {std::string(kBegin) + Record(1, "0 0 - 138 40 328 40 138 130", "0 0.1 0 0 0 280 0.01 0 0 - -"),
+       "the value of check 6 (squareness) of the record of cycle 1 of fixture 'Board' is 280: outside 0..270 deg"},
+      {std::string(kBegin) + Record(1, "0 0 - 138 40 328 40 138 130", "0 0.1 0 0 0 0 0.01 0 200 - -"),
+       "the value of check 9 (nominal_rotation) of the record of cycle 1 of fixture 'Board' is 200: outside 0..180 "
+       "deg"},
       {std::string(kBegin) + Record(1, "0 0 - 138 40 328 40 138 130", "3 0.1 0 0 0 0 0.01 0 0 - -"),
        "the value of check 1 (missing_trip) of the record of cycle 1 of fixture 'Board' is 3: outside 0..2 trips"},
       {std::string(kBegin) + Record(1, "7 0 - 138 40 328 40 138 130", "0 0.1 0 0 0 0 - 0 0 - -"),

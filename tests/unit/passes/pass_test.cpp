@@ -105,7 +105,7 @@ TEST(RunPassesDeathTest, VerifyEachChecksTheInputFirst) {
   WaitProgram(b);
   BreakIr().Run(b.program, *std::make_unique<Diagnostics>(b.sources));
   Diagnostics diags(b.sources);
-  EXPECT_EXIT(RunPasses(b.program, diags, std::vector<std::string>{}, /*verify_each=*/true),
+  EXPECT_EXIT((void)RunPasses(b.program, diags, std::vector<std::string>{}, /*verify_each=*/true),
               testing::ExitedWithCode(3), "the IR is broken in the input to the first pass");
 }
 
