@@ -138,31 +138,29 @@ bool Diagnostics::Keeps(DiagKind kind) const {
 
 // Every diagnostic is counted, kept or not: a reader that asks whether its
 // part of the input had an error (error_count() before and after) gets the
-// truth after the limit too. Constant time per diagnostic.
+// truth after the limit too. Constant time per diagnostic. Whether it is
+// kept is Keeps' rule; the first error and the first warning past their
+// limits leave a marker in its place.
 Diagnostic* Diagnostics::Add(DiagKind kind, SourceRange range, std::string message) {
-  Severity severity = DiagKindSeverity(kind);
+  const Severity severity = DiagKindSeverity(kind);
+  const bool keep = Keeps(kind);
   if (severity == Severity::Error) {
-    if (error_count_ >= error_limit_) {
-      if (!limit_reached_) {
-        limit_reached_ = true;
-        diagnostics_.push_back({DiagKind::TooManyErrors, Severity::Error, range,
-                                fmt::format("too many errors ({}); stopping here", error_count_), {}});
-      }
-      ++error_count_;
-      return nullptr;
+    if (!keep && !limit_reached_) {
+      limit_reached_ = true;
+      diagnostics_.push_back({DiagKind::TooManyErrors, Severity::Error, range,
+                              fmt::format("too many errors ({}); stopping here", error_count_), {}});
     }
     ++error_count_;
-  } else if (severity == Severity::Warning && ++warning_count_ > warning_limit_) {
-    // Counted (the summaries say how many), but no longer shown.
-    if (warning_count_ == warning_limit_ + 1 && !limit_reached_) {
+  } else if (severity == Severity::Warning) {
+    // Counted (the summaries say how many), but past the limit no longer shown.
+    if (++warning_count_ == warning_limit_ + 1 && !limit_reached_) {
       diagnostics_.push_back({DiagKind::TooManyWarnings, Severity::Warning, range,
                               fmt::format("more than {} warnings; the others are counted but not shown",
                                           warning_limit_),
                               {}});
     }
-    return nullptr;
   }
-  if (limit_reached_) return nullptr;
+  if (!keep) return nullptr;
   diagnostics_.push_back({kind, severity, range, Printed(message), {}});
   return &diagnostics_.back();
 }
